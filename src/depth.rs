@@ -1,0 +1,149 @@
+//! Depth buffers: `u16`, `u32` or none at all.
+//!
+//! Design note: the rasterizer is generic over [`DepthBuffer`], so a scene
+//! drawn with [`NoDepth`] compiles to a loop with no depth arithmetic in it
+//! ([`DepthBuffer::ENABLED`] is a constant). Depth values are window depth
+//! in `[0, 1]`: `Z32` (`u32`, `z * 2^32` saturated) or `Z16` (`u16`, the top
+//! 16 bits of `Z32`). Clear a buffer to `u16::MAX` / `u32::MAX` (the far
+//! plane) before drawing with [`DepthFunc::Less`].
+
+/// The depth comparison: a fragment passes when `func(new, stored)` holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DepthFunc {
+    /// Never passes.
+    Never,
+    /// `new < stored` (the default).
+    #[default]
+    Less,
+    /// `new == stored`.
+    Equal,
+    /// `new <= stored`.
+    LessEqual,
+    /// `new > stored`.
+    Greater,
+    /// `new != stored`.
+    NotEqual,
+    /// `new >= stored`.
+    GreaterEqual,
+    /// Always passes.
+    Always,
+}
+
+impl DepthFunc {
+    /// Whether a fragment at depth `new` passes against `stored`.
+    #[inline]
+    pub fn test<T: Ord>(self, new: T, stored: T) -> bool {
+        match self {
+            DepthFunc::Never => false,
+            DepthFunc::Less => new < stored,
+            DepthFunc::Equal => new == stored,
+            DepthFunc::LessEqual => new <= stored,
+            DepthFunc::Greater => new > stored,
+            DepthFunc::NotEqual => new != stored,
+            DepthFunc::GreaterEqual => new >= stored,
+            DepthFunc::Always => true,
+        }
+    }
+}
+
+/// Depth storage for the rows being rendered.
+///
+/// Implemented for `[u16]`, `[u32]` and [`NoDepth`]. Pass `&mut depth[..]`
+/// (or `&mut NoDepth`) to [`Frame::render_rows`](crate::Frame::render_rows).
+pub trait DepthBuffer {
+    /// `false` only for [`NoDepth`]: no depth value is computed at all.
+    const ENABLED: bool;
+
+    /// The number of depth values held, or `None` without a buffer.
+    fn depth_len(&self) -> Option<usize>;
+
+    /// Tests `z` (`Z32`) against the value at `index` and, if it passes and
+    /// `write` is set, stores it. An index out of range fails the test.
+    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool;
+}
+
+impl DepthBuffer for [u32] {
+    const ENABLED: bool = true;
+
+    fn depth_len(&self) -> Option<usize> {
+        Some(self.len())
+    }
+
+    #[inline]
+    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
+        match self.get_mut(index) {
+            Some(d) if func.test(z, *d) => {
+                if write {
+                    *d = z;
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+impl DepthBuffer for [u16] {
+    const ENABLED: bool = true;
+
+    fn depth_len(&self) -> Option<usize> {
+        Some(self.len())
+    }
+
+    #[inline]
+    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
+        let z = (z >> 16) as u16;
+        match self.get_mut(index) {
+            Some(d) if func.test(z, *d) => {
+                if write {
+                    *d = z;
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+/// No depth buffer: every fragment passes and no depth is computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoDepth;
+
+impl DepthBuffer for NoDepth {
+    const ENABLED: bool = false;
+
+    fn depth_len(&self) -> Option<usize> {
+        None
+    }
+
+    #[inline]
+    fn test_and_set(&mut self, _: usize, _: u32, _: DepthFunc, _: bool) -> bool {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn funcs() {
+        assert!(DepthFunc::Less.test(1, 2));
+        assert!(!DepthFunc::Less.test(2, 2));
+        assert!(DepthFunc::LessEqual.test(2, 2));
+        assert!(DepthFunc::Always.test(9, 2));
+        assert!(!DepthFunc::Never.test(0, 2));
+        assert!(DepthFunc::Greater.test(3, 2));
+        assert!(DepthFunc::GreaterEqual.test(2, 2));
+        assert!(DepthFunc::Equal.test(2, 2));
+        assert!(DepthFunc::NotEqual.test(1, 2));
+    }
+
+    #[test]
+    fn u16_uses_top_bits_and_out_of_range_fails() {
+        let mut d = [u16::MAX; 2];
+        assert!(d[..].test_and_set(0, 0x1234_5678, DepthFunc::Less, true));
+        assert_eq!(d[0], 0x1234);
+        assert!(!d[..].test_and_set(5, 0, DepthFunc::Always, true));
+    }
+}

@@ -1,0 +1,175 @@
+//! Fixed-point formats and snapping: where floats end.
+//!
+//! Design note: the vertex stage hands over `f32` clip-space positions; this
+//! module is the single place they become integers. After it, coverage,
+//! culling and depth interpolation are decided by exact integer arithmetic
+//! only. Every format is named after its layout and carries its range:
+//!
+//! | name | type | meaning | range |
+//! |---|---|---|---|
+//! | `Sub<S>` | `i32` | window coordinate in units of `2^-S` pixel (S = [`SUBPIXEL_BITS`] 8 by default, or 4) | `|v| <= COORD_LIMIT = 2^28` |
+//! | edge value | `i64` | twice the signed area of (edge, point) in `Sub<S>^2` units | `|e| < 2^59` |
+//! | `Z32` | `u32` | window depth `[0, 1]` scaled by `2^32`, saturated to `u32::MAX` | `0 ..= 2^32 - 1` |
+//! | `Z32.16` | `i64` | interpolated depth: `Z32` with 16 more fraction bits | `0 ..= 2^48 - 1` at covered pixels |
+//!
+//! Ranges and why they hold:
+//! - The frame is at most [`MAX_DIMENSION`] = 16384 pixels a side, so a pixel
+//!   centre is at most `2^14 * 2^8 = 2^22` in `Sub<8>`.
+//! - Triangles are clipped to a guard band of `|v| <= GUARD_BAND = 2^27`
+//!   (in NDC: `|x| <= g_x w` with `g_x` from [`guard_band_ndc`]). Float
+//!   rounding in the clipper can overshoot that by far less than a factor of
+//!   two, and snapping rejects anything beyond `COORD_LIMIT = 2^28`, so
+//!   every stored coordinate obeys `|v| <= 2^28` whatever the input was.
+//! - Edge function: `dx * (py - ay) - dy * (px - ax)` with `|dx|, |dy| <=
+//!   2^29` and `|p - a| < 2^29` gives `|e| < 2^59`, and the per-pixel step
+//!   `dy << S` is below `2^37`: `i64` never overflows.
+//! - Twice the triangle area is bounded the same way: `< 2^59`.
+//!
+//! Largest frame and guard band per subpixel precision:
+//!
+//! | S | subpixel | largest frame | guard band (pixels from the origin) |
+//! |---|---|---|---|
+//! | 8 | 1/256 px | 16384 x 16384 | ±2^19 = ±524,288 |
+//! | 4 | 1/16 px | 16384 x 16384 | ±2^23 = ±8,388,608 |
+
+use crate::math::fx;
+
+/// The default number of subpixel bits (1/256 pixel).
+pub const SUBPIXEL_BITS: u32 = 8;
+
+/// The largest frame width or height, in pixels.
+pub const MAX_DIMENSION: u32 = 1 << 14;
+
+/// The guard band: clipping keeps window coordinates within `±GUARD_BAND`
+/// `Sub<S>` units.
+pub const GUARD_BAND: i32 = 1 << 27;
+
+/// The hard limit on a snapped coordinate, `Sub<S>` units: twice the guard
+/// band, so float rounding in the clipper can never reach it by accident.
+pub const COORD_LIMIT: i32 = 1 << 28;
+
+/// A vertex snapped to window space.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SnappedVertex {
+    /// Window x in `Sub<S>` units (pixel centre of column `i` is at
+    /// `(i << S) + (1 << (S - 1))`).
+    pub x: i32,
+    /// Window y in `Sub<S>` units, rows counted from the top.
+    pub y: i32,
+    /// Window depth in `Z32`.
+    pub z: u32,
+}
+
+/// The guard band in NDC units for a frame of `width x height` pixels at
+/// `S` subpixel bits: clipping keeps `|x| <= gx * w` and `|y| <= gy * w`.
+///
+/// Chosen so that `(gx + 1) * width / 2 * 2^S <= GUARD_BAND`.
+pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
+    let limit = (GUARD_BAND >> S) as f32; // pixels
+    let gx = 2.0 * limit / width as f32 - 1.0;
+    let gy = 2.0 * limit / height as f32 - 1.0;
+    (gx, gy)
+}
+
+/// Rounds `v` to the nearest integer (halves up) and checks the result is
+/// within `±COORD_LIMIT`. `None` for NaN, infinities and out-of-range values.
+#[inline]
+fn round_to_coord(v: f32) -> Option<i32> {
+    let r = fx::floor(v + 0.5);
+    if r.is_finite() && r.abs() <= COORD_LIMIT as f32 {
+        Some(r as i32)
+    } else {
+        None
+    }
+}
+
+/// Snaps a clip-space position to window space at `S` subpixel bits.
+///
+/// Window x = `(x/w + 1) * width / 2`, window y = `(1 - y/w) * height / 2`
+/// (row 0 is the top), window z = `(z/w + 1) / 2`. Both x and y are then
+/// scaled by `2^S` and rounded to the nearest integer, halves up. Returns
+/// `None` if `w` is not positive or a result is not finite or beyond
+/// [`COORD_LIMIT`]; the caller counts that as rejected.
+pub fn snap<const S: u32>(
+    x: f32,
+    y: f32,
+    z: f32,
+    w: f32,
+    width: u32,
+    height: u32,
+) -> Option<SnappedVertex> {
+    if !(w > 0.0) {
+        return None;
+    }
+    let inv_w = 1.0 / w;
+    let half_w = width as f32 * 0.5;
+    let half_h = height as f32 * 0.5;
+    let scale = (1u32 << S) as f32;
+    let wx = (x * inv_w * half_w + half_w) * scale;
+    let wy = (half_h - y * inv_w * half_h) * scale;
+    let zw = z * inv_w * 0.5 + 0.5;
+    if !zw.is_finite() {
+        return None;
+    }
+    Some(SnappedVertex {
+        x: round_to_coord(wx)?,
+        y: round_to_coord(wy)?,
+        z: z01_to_z32(zw),
+    })
+}
+
+/// Window depth in `[0, 1]` to `Z32` (saturating; values outside `[0, 1]`
+/// clamp, NaN gives 0).
+#[inline]
+pub fn z01_to_z32(z: f32) -> u32 {
+    // `as` from float saturates and maps NaN to 0: no panic, no UB.
+    (z * 4_294_967_296.0) as u32
+}
+
+/// The `Sub<S>` coordinate of the centre of pixel column (or row) `i`.
+#[inline]
+pub const fn pixel_center<const S: u32>(i: i32) -> i64 {
+    ((i as i64) << S) + (1i64 << (S - 1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn snap_maps_ndc_corners_to_frame_corners() {
+        let v = snap::<8>(-1.0, 1.0, -1.0, 1.0, 64, 32).unwrap();
+        assert_eq!((v.x, v.y, v.z), (0, 0, 0));
+        let v = snap::<8>(1.0, -1.0, 1.0, 1.0, 64, 32).unwrap();
+        assert_eq!((v.x, v.y, v.z), (64 << 8, 32 << 8, u32::MAX));
+    }
+
+    #[test]
+    fn snap_rejects_nonpositive_w_and_nonfinite() {
+        assert!(snap::<8>(0.0, 0.0, 0.0, 0.0, 8, 8).is_none());
+        assert!(snap::<8>(0.0, 0.0, 0.0, -1.0, 8, 8).is_none());
+        assert!(snap::<8>(f32::NAN, 0.0, 0.0, 1.0, 8, 8).is_none());
+        assert!(snap::<8>(0.0, f32::INFINITY, 0.0, 1.0, 8, 8).is_none());
+        assert!(snap::<8>(1e30, 0.0, 0.0, 1.0, 8, 8).is_none());
+    }
+
+    #[test]
+    fn guard_band_fits_coord_limit_for_largest_frame() {
+        for s in [4u32, 8] {
+            let (gx, _) = if s == 8 {
+                guard_band_ndc::<8>(MAX_DIMENSION, MAX_DIMENSION)
+            } else {
+                guard_band_ndc::<4>(MAX_DIMENSION, MAX_DIMENSION)
+            };
+            assert!(gx >= 1.0);
+            let edge = (gx + 1.0) * (MAX_DIMENSION as f32 / 2.0) * (1u32 << s) as f32;
+            assert!(edge <= GUARD_BAND as f32 * 1.0001, "s={s} edge={edge}");
+        }
+    }
+
+    #[test]
+    fn pixel_centers() {
+        assert_eq!(pixel_center::<8>(0), 128);
+        assert_eq!(pixel_center::<4>(3), 56);
+    }
+}

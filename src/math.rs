@@ -1,0 +1,406 @@
+//! Vertex-stage math in `f32`: vectors, 4x4 matrices and the float shim.
+//!
+//! Design note: everything before snapping runs in IEEE `f32`, in a fixed
+//! order of operations, with no fused multiply-add (Rust never contracts
+//! `a * b + c` on its own), so the host and a Cortex-M build compute the same
+//! bits. Transcendental functions (`sin`, `cos`, `tan`, `sqrt`, `floor`) go
+//! through the one shim at the top of this file, chosen by cargo feature:
+//! `libm` (default, correctly rounded or close to it) or `micromath` (fast
+//! approximations). Nothing here decides coverage: the only float that
+//! reaches the rasterizer is rounded to a named fixed-point format in
+//! [`crate::fixed`] first.
+
+#[cfg(not(any(feature = "libm", feature = "micromath")))]
+compile_error!("microraster needs a float backend: enable feature `libm` (default) or `micromath`");
+
+/// The float shim: one place where the math backend is chosen.
+#[cfg(feature = "libm")]
+pub(crate) mod fx {
+    #[inline]
+    pub fn sin(x: f32) -> f32 {
+        libm::sinf(x)
+    }
+    #[inline]
+    pub fn cos(x: f32) -> f32 {
+        libm::cosf(x)
+    }
+    #[inline]
+    pub fn tan(x: f32) -> f32 {
+        libm::tanf(x)
+    }
+    #[inline]
+    pub fn sqrt(x: f32) -> f32 {
+        libm::sqrtf(x)
+    }
+    #[inline]
+    pub fn floor(x: f32) -> f32 {
+        libm::floorf(x)
+    }
+}
+
+/// The float shim: one place where the math backend is chosen.
+#[cfg(all(feature = "micromath", not(feature = "libm")))]
+pub(crate) mod fx {
+    use micromath::F32Ext;
+    #[inline]
+    pub fn sin(x: f32) -> f32 {
+        x.sin()
+    }
+    #[inline]
+    pub fn cos(x: f32) -> f32 {
+        x.cos()
+    }
+    #[inline]
+    pub fn tan(x: f32) -> f32 {
+        x.tan()
+    }
+    #[inline]
+    pub fn sqrt(x: f32) -> f32 {
+        x.sqrt()
+    }
+    #[inline]
+    pub fn floor(x: f32) -> f32 {
+        x.floor()
+    }
+}
+
+use core::ops::{Add, Mul, Neg, Sub};
+
+/// A 3-component `f32` vector (object or world space).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vec3 {
+    /// x component.
+    pub x: f32,
+    /// y component.
+    pub y: f32,
+    /// z component.
+    pub z: f32,
+}
+
+impl Vec3 {
+    /// The zero vector.
+    pub const ZERO: Vec3 = Vec3::new(0.0, 0.0, 0.0);
+
+    /// Builds a vector.
+    pub const fn new(x: f32, y: f32, z: f32) -> Self {
+        Vec3 { x, y, z }
+    }
+
+    /// Builds a vector from an array.
+    pub const fn from_array(a: [f32; 3]) -> Self {
+        Vec3::new(a[0], a[1], a[2])
+    }
+
+    /// Dot product.
+    pub fn dot(self, o: Vec3) -> f32 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// Cross product.
+    pub fn cross(self, o: Vec3) -> Vec3 {
+        Vec3::new(
+            self.y * o.z - self.z * o.y,
+            self.z * o.x - self.x * o.z,
+            self.x * o.y - self.y * o.x,
+        )
+    }
+
+    /// Euclidean length.
+    pub fn length(self) -> f32 {
+        fx::sqrt(self.dot(self))
+    }
+
+    /// This vector scaled to unit length; the zero vector stays zero.
+    pub fn normalize(self) -> Vec3 {
+        let len = self.length();
+        if len > 0.0 {
+            self * (1.0 / len)
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Extends to a point (`w = 1`).
+    pub const fn extend(self, w: f32) -> Vec4 {
+        Vec4::new(self.x, self.y, self.z, w)
+    }
+
+    /// True if every component is finite.
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
+    }
+}
+
+impl Add for Vec3 {
+    type Output = Vec3;
+    fn add(self, o: Vec3) -> Vec3 {
+        Vec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl Sub for Vec3 {
+    type Output = Vec3;
+    fn sub(self, o: Vec3) -> Vec3 {
+        Vec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl Neg for Vec3 {
+    type Output = Vec3;
+    fn neg(self) -> Vec3 {
+        Vec3::new(-self.x, -self.y, -self.z)
+    }
+}
+
+impl Mul<f32> for Vec3 {
+    type Output = Vec3;
+    fn mul(self, s: f32) -> Vec3 {
+        Vec3::new(self.x * s, self.y * s, self.z * s)
+    }
+}
+
+/// A homogeneous `f32` vector: a clip-space position `(x, y, z, w)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vec4 {
+    /// x component.
+    pub x: f32,
+    /// y component.
+    pub y: f32,
+    /// z component.
+    pub z: f32,
+    /// w component.
+    pub w: f32,
+}
+
+impl Vec4 {
+    /// Builds a vector.
+    pub const fn new(x: f32, y: f32, z: f32, w: f32) -> Self {
+        Vec4 { x, y, z, w }
+    }
+
+    /// Builds a vector from an array.
+    pub const fn from_array(a: [f32; 4]) -> Self {
+        Vec4::new(a[0], a[1], a[2], a[3])
+    }
+
+    /// True if every component is finite (no NaN, no infinity).
+    pub fn is_finite(self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite() && self.w.is_finite()
+    }
+
+    /// `self + (o - self) * t`, component-wise, in a fixed order.
+    pub fn lerp(self, o: Vec4, t: f32) -> Vec4 {
+        Vec4::new(
+            self.x + (o.x - self.x) * t,
+            self.y + (o.y - self.y) * t,
+            self.z + (o.z - self.z) * t,
+            self.w + (o.w - self.w) * t,
+        )
+    }
+}
+
+/// A column-major 4x4 `f32` matrix acting on column vectors (`M * v`), as in
+/// OpenGL and glam. `cols[c][r]` is row `r` of column `c`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mat4 {
+    /// The four columns.
+    pub cols: [[f32; 4]; 4],
+}
+
+impl Default for Mat4 {
+    fn default() -> Self {
+        Mat4::IDENTITY
+    }
+}
+
+impl Mat4 {
+    /// The identity matrix.
+    pub const IDENTITY: Mat4 = Mat4 {
+        cols: [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ],
+    };
+
+    /// Builds a matrix from rows, as it is written on paper.
+    pub const fn from_rows(r: [[f32; 4]; 4]) -> Mat4 {
+        Mat4 {
+            cols: [
+                [r[0][0], r[1][0], r[2][0], r[3][0]],
+                [r[0][1], r[1][1], r[2][1], r[3][1]],
+                [r[0][2], r[1][2], r[2][2], r[3][2]],
+                [r[0][3], r[1][3], r[2][3], r[3][3]],
+            ],
+        }
+    }
+
+    /// Row `r` as an array.
+    pub const fn row(&self, r: usize) -> [f32; 4] {
+        [
+            self.cols[0][r],
+            self.cols[1][r],
+            self.cols[2][r],
+            self.cols[3][r],
+        ]
+    }
+
+    /// A translation by `t`.
+    pub const fn translation(t: Vec3) -> Mat4 {
+        Mat4::from_rows([
+            [1.0, 0.0, 0.0, t.x],
+            [0.0, 1.0, 0.0, t.y],
+            [0.0, 0.0, 1.0, t.z],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// A non-uniform scale.
+    pub const fn scale(s: Vec3) -> Mat4 {
+        Mat4::from_rows([
+            [s.x, 0.0, 0.0, 0.0],
+            [0.0, s.y, 0.0, 0.0],
+            [0.0, 0.0, s.z, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// A right-handed rotation by `radians` about the x axis.
+    pub fn rotation_x(radians: f32) -> Mat4 {
+        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::from_rows([
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, c, -s, 0.0],
+            [0.0, s, c, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// A right-handed rotation by `radians` about the y axis.
+    pub fn rotation_y(radians: f32) -> Mat4 {
+        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::from_rows([
+            [c, 0.0, s, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [-s, 0.0, c, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// A right-handed rotation by `radians` about the z axis.
+    pub fn rotation_z(radians: f32) -> Mat4 {
+        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::from_rows([
+            [c, -s, 0.0, 0.0],
+            [s, c, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// An OpenGL perspective projection (right-handed eye space looking down
+    /// -z, clip z in `[-w, w]`), like `gluPerspective`.
+    pub fn perspective(fov_y_radians: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+        let f = 1.0 / fx::tan(fov_y_radians * 0.5);
+        let nf = 1.0 / (near - far);
+        Mat4::from_rows([
+            [f / aspect, 0.0, 0.0, 0.0],
+            [0.0, f, 0.0, 0.0],
+            [0.0, 0.0, (far + near) * nf, 2.0 * far * near * nf],
+            [0.0, 0.0, -1.0, 0.0],
+        ])
+    }
+
+    /// A right-handed view matrix looking from `eye` at `target`, like
+    /// `gluLookAt`.
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
+        let f = (target - eye).normalize();
+        let s = f.cross(up).normalize();
+        let u = s.cross(f);
+        Mat4::from_rows([
+            [s.x, s.y, s.z, -s.dot(eye)],
+            [u.x, u.y, u.z, -u.dot(eye)],
+            [-f.x, -f.y, -f.z, f.dot(eye)],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// `self * v`.
+    pub fn mul_vec4(&self, v: Vec4) -> Vec4 {
+        let c = &self.cols;
+        Vec4::new(
+            c[0][0] * v.x + c[1][0] * v.y + c[2][0] * v.z + c[3][0] * v.w,
+            c[0][1] * v.x + c[1][1] * v.y + c[2][1] * v.z + c[3][1] * v.w,
+            c[0][2] * v.x + c[1][2] * v.y + c[2][2] * v.z + c[3][2] * v.w,
+            c[0][3] * v.x + c[1][3] * v.y + c[2][3] * v.z + c[3][3] * v.w,
+        )
+    }
+
+    /// `self * (p, 1)`: a point to clip space.
+    pub fn transform_point(&self, p: Vec3) -> Vec4 {
+        self.mul_vec4(p.extend(1.0))
+    }
+
+    /// True if every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.cols.iter().flatten().all(|v| v.is_finite())
+    }
+}
+
+impl Mul for Mat4 {
+    type Output = Mat4;
+    fn mul(self, o: Mat4) -> Mat4 {
+        let mut cols = [[0.0; 4]; 4];
+        for (c, col) in cols.iter_mut().enumerate() {
+            let v = self.mul_vec4(Vec4::from_array(o.cols[c]));
+            *col = [v.x, v.y, v.z, v.w];
+        }
+        Mat4 { cols }
+    }
+}
+
+/// Degrees to radians.
+pub fn radians(deg: f32) -> f32 {
+    deg * (core::f32::consts::PI / 180.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec4, b: Vec4) -> bool {
+        (a.x - b.x).abs() < 1e-5
+            && (a.y - b.y).abs() < 1e-5
+            && (a.z - b.z).abs() < 1e-5
+            && (a.w - b.w).abs() < 1e-5
+    }
+
+    #[test]
+    fn translate_then_rotate_order() {
+        // R * T: the point is translated first, then rotated.
+        let m = Mat4::rotation_z(radians(90.0)) * Mat4::translation(Vec3::new(1.0, 0.0, 0.0));
+        let p = m.transform_point(Vec3::ZERO);
+        assert!(close(p, Vec4::new(0.0, 1.0, 0.0, 1.0)), "{p:?}");
+    }
+
+    #[test]
+    fn perspective_maps_near_and_far_to_minus_and_plus_w() {
+        let m = Mat4::perspective(radians(60.0), 1.0, 0.5, 10.0);
+        let n = m.transform_point(Vec3::new(0.0, 0.0, -0.5));
+        let f = m.transform_point(Vec3::new(0.0, 0.0, -10.0));
+        assert!((n.z / n.w + 1.0).abs() < 1e-5);
+        assert!((f.z / f.w - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn look_at_puts_target_on_minus_z() {
+        let v = Mat4::look_at(
+            Vec3::new(0.0, 3.0, 5.0),
+            Vec3::ZERO,
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let p = v.transform_point(Vec3::ZERO);
+        assert!(p.x.abs() < 1e-5 && p.y.abs() < 1e-5 && p.z < 0.0);
+    }
+}

@@ -1,0 +1,227 @@
+//! Triangle setup: snapped vertices to a compact, exact triangle record.
+//!
+//! Design note: setup runs once per (clipped) triangle per frame and decides
+//! everything that does not depend on the rows being rendered:
+//!
+//! 1. snap the three vertices ([`crate::fixed::snap`]); a vertex that
+//!    cannot be snapped (non-finite, `w <= 0` after clipping) rejects the
+//!    triangle;
+//! 2. twice the signed area, exactly, in `i64` (`|area| < 2^59`): zero area
+//!    is rejected, the sign decides back-face culling;
+//! 3. the winding is normalised so the area is positive (vertices 1 and 2
+//!    swapped with their attributes), which makes every edge function
+//!    positive inside;
+//! 4. the pixel bounding box of the snapped vertices: pixels whose centres
+//!    lie in it. An empty box ("no sample") is rejected; a box that misses
+//!    the frame is culled.
+//!
+//! The record keeps vertices, not edge coefficients: the rasterizer derives
+//! those in a handful of integer operations per strip, which keeps the
+//! record small for RAM-starved targets.
+
+use crate::clip::ClipVertex;
+use crate::fixed::snap;
+use crate::frame::{CullMode, FrontFace};
+use embedded_graphics_core::pixelcolor::Rgb888;
+
+/// A triangle after setup, ready to rasterize into any rows of its frame.
+///
+/// Frames store these in caller-provided storage (see
+/// [`Frame::new`](crate::Frame::new)); [`SetupTriangle::EMPTY`] fills it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SetupTriangle {
+    /// Vertex x in `Sub<S>` units, wound so that `area > 0`.
+    pub(crate) x: [i32; 3],
+    /// Vertex y in `Sub<S>` units (rows from the top).
+    pub(crate) y: [i32; 3],
+    /// Vertex depth in `Z32`.
+    pub(crate) z: [u32; 3],
+    /// Twice the signed area in `Sub<S>^2` units; always `> 0`.
+    pub(crate) area: i64,
+    /// Inclusive pixel bounding box, clamped to the frame.
+    pub(crate) min_x: u16,
+    pub(crate) max_x: u16,
+    pub(crate) min_y: u16,
+    pub(crate) max_y: u16,
+    /// For perspective-correct colour: `w_min / w_k` (in `(0, 1]`).
+    pub(crate) inv_w: [f32; 3],
+    /// Colour times `inv_w`, per vertex.
+    pub(crate) color_w: [[f32; 3]; 3],
+    /// The colour when the triangle is flat (all vertex colours equal).
+    pub(crate) flat: Rgb888,
+    /// Whether colour varies over the triangle.
+    pub(crate) smooth: bool,
+    /// The caller's triangle index.
+    pub(crate) id: u32,
+}
+
+impl SetupTriangle {
+    /// A placeholder to fill storage with.
+    pub const EMPTY: SetupTriangle = SetupTriangle {
+        x: [0; 3],
+        y: [0; 3],
+        z: [0; 3],
+        area: 0,
+        min_x: 0,
+        max_x: 0,
+        min_y: 0,
+        max_y: 0,
+        inv_w: [0.0; 3],
+        color_w: [[0.0; 3]; 3],
+        flat: Rgb888::new(0, 0, 0),
+        smooth: false,
+        id: 0,
+    };
+
+    /// The caller's index of the triangle this one came from.
+    pub fn id(&self) -> u32 {
+        self.id
+    }
+
+    /// The first and last pixel row this triangle may cover (inclusive).
+    pub fn rows(&self) -> (u16, u16) {
+        (self.min_y, self.max_y)
+    }
+
+    /// The snapped vertices `(x, y)` in subpixel units, wound so the signed
+    /// area is positive.
+    pub fn vertices(&self) -> [(i32, i32); 3] {
+        [
+            (self.x[0], self.y[0]),
+            (self.x[1], self.y[1]),
+            (self.x[2], self.y[2]),
+        ]
+    }
+
+    /// The snapped window depths in `Z32`.
+    pub fn depths(&self) -> [u32; 3] {
+        self.z
+    }
+}
+
+impl Default for SetupTriangle {
+    fn default() -> Self {
+        SetupTriangle::EMPTY
+    }
+}
+
+/// Why setup produced no triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Rejected {
+    /// Culled as a back (or front) face.
+    Backface,
+    /// Zero area, or no pixel centre inside the bounding box.
+    Degenerate,
+    /// The bounding box misses the frame.
+    Offscreen,
+    /// A vertex could not be snapped (non-finite or `w <= 0`).
+    NonFinite,
+}
+
+/// Twice the signed area of a triangle in window space (y down), exactly.
+#[inline]
+pub(crate) fn area2(x: [i32; 3], y: [i32; 3]) -> i64 {
+    let (x0, y0) = (x[0] as i64, y[0] as i64);
+    (x[1] as i64 - x0) * (y[2] as i64 - y0) - (x[2] as i64 - x0) * (y[1] as i64 - y0)
+}
+
+/// Sets up one clipped triangle for a `width x height` frame at `S`
+/// subpixel bits.
+pub(crate) fn setup<const S: u32>(
+    v: &[ClipVertex; 3],
+    width: u32,
+    height: u32,
+    cull: CullMode,
+    front: FrontFace,
+    id: u32,
+) -> Result<SetupTriangle, Rejected> {
+    let mut sx = [0i32; 3];
+    let mut sy = [0i32; 3];
+    let mut sz = [0u32; 3];
+    for k in 0..3 {
+        let p = v[k].pos;
+        let s = snap::<S>(p.x, p.y, p.z, p.w, width, height).ok_or(Rejected::NonFinite)?;
+        sx[k] = s.x;
+        sy[k] = s.y;
+        sz[k] = s.z;
+    }
+    let area = area2(sx, sy);
+    if area == 0 {
+        return Err(Rejected::Degenerate);
+    }
+    // Window y points down, so a counter-clockwise triangle in NDC has a
+    // negative window-space area.
+    let ccw = area < 0;
+    let is_front = match front {
+        FrontFace::Ccw => ccw,
+        FrontFace::Cw => !ccw,
+    };
+    match cull {
+        CullMode::Back if !is_front => return Err(Rejected::Backface),
+        CullMode::Front if is_front => return Err(Rejected::Backface),
+        _ => {}
+    }
+    let mut order = [0usize, 1, 2];
+    let mut area = area;
+    if area < 0 {
+        order = [0, 2, 1];
+        area = -area;
+    }
+    let x = [sx[order[0]], sx[order[1]], sx[order[2]]];
+    let y = [sy[order[0]], sy[order[1]], sy[order[2]]];
+    let z = [sz[order[0]], sz[order[1]], sz[order[2]]];
+
+    // Pixels whose centre (i << S) + half lies in [min, max].
+    let half = 1i64 << (S - 1);
+    let one = 1i64 << S;
+    let min_x = *x.iter().min().unwrap_or(&0) as i64;
+    let max_x = *x.iter().max().unwrap_or(&0) as i64;
+    let min_y = *y.iter().min().unwrap_or(&0) as i64;
+    let max_y = *y.iter().max().unwrap_or(&0) as i64;
+    let px0 = (min_x - half + one - 1) >> S;
+    let px1 = (max_x - half) >> S;
+    let py0 = (min_y - half + one - 1) >> S;
+    let py1 = (max_y - half) >> S;
+    if px0 > px1 || py0 > py1 {
+        return Err(Rejected::Degenerate);
+    }
+    let (w, h) = (width as i64, height as i64);
+    if px1 < 0 || py1 < 0 || px0 >= w || py0 >= h {
+        return Err(Rejected::Offscreen);
+    }
+    let clamp = |v: i64, hi: i64| v.clamp(0, hi) as u16;
+
+    // Colour: flat when all three vertex colours are equal.
+    let c = [v[order[0]].color, v[order[1]].color, v[order[2]].color];
+    let smooth = c[0] != c[1] || c[0] != c[2];
+    let to_u8 = |f: f32| (f + 0.5) as u8;
+    let flat = Rgb888::new(to_u8(c[0][0]), to_u8(c[0][1]), to_u8(c[0][2]));
+    let mut inv_w = [1.0f32; 3];
+    let mut color_w = [[0.0f32; 3]; 3];
+    if smooth {
+        let ws = [v[order[0]].pos.w, v[order[1]].pos.w, v[order[2]].pos.w];
+        let w_min = ws[0].min(ws[1]).min(ws[2]);
+        for k in 0..3 {
+            inv_w[k] = w_min / ws[k];
+            for ch in 0..3 {
+                color_w[k][ch] = c[k][ch] * inv_w[k];
+            }
+        }
+    }
+
+    Ok(SetupTriangle {
+        x,
+        y,
+        z,
+        area,
+        min_x: clamp(px0, w - 1),
+        max_x: clamp(px1, w - 1),
+        min_y: clamp(py0, h - 1),
+        max_y: clamp(py1, h - 1),
+        inv_w,
+        color_w,
+        flat,
+        smooth,
+        id,
+    })
+}
