@@ -98,7 +98,7 @@ pub fn snap<const S: u32>(
     width: u32,
     height: u32,
 ) -> Option<SnappedVertex> {
-    if !(w > 0.0) {
+    if w.is_nan() || w <= 0.0 {
         return None;
     }
     let inv_w = 1.0 / w;

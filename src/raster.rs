@@ -6,9 +6,10 @@
 //!
 //! `E_k(p) = (xb - xa) * (py - ya) - (yb - ya) * (px - xa)` for the edge
 //! `a -> b` opposite vertex `k`, in `i64` (`|E| < 2^59`, see
-//! [`crate::fixed`]). A pixel is covered when its centre has `E_k + bias_k
-//! >= 0` for all `k`, where `bias_k` is 0 for a top or left edge and -1
-//! otherwise: the top-left fill rule, exactly, with no float anywhere.
+//! [`crate::fixed`]). A pixel is covered when its centre has
+//! `E_k + bias_k >= 0` for all `k`, where `bias_k` is 0 for a top or left
+//! edge and -1 otherwise: the top-left fill rule, exactly, with no float
+//! anywhere.
 //!
 //! Per row, each edge is linear in the column, so the covered columns are
 //! found by one exact floor division per edge: a span `[lo, hi]`. The inner

@@ -1,0 +1,492 @@
+//! Command-line definitions for the `microraster` binary (clap derive).
+//!
+//! Design: every option is validated while parsing (value parsers below), so
+//! the renderer receives only well-formed settings and the user gets clap's
+//! usual error message and exit status for bad input: sizes within
+//! 1..=16384, a positive thread and strip count, a field of view strictly
+//! between 0° and 180°, finite camera vectors, an output path whose extension
+//! names a supported format. `--obj`, `--clip-tris` and an explicit `--scene`
+//! are mutually exclusive; [`RenderArgs::source`] says which one to use.
+//! Vectors are written `X,Y,Z`; negative values work both as `--eye -1,2,3`
+//! and `--eye=-1,2,3`.
+
+use std::path::PathBuf;
+
+use clap::builder::PossibleValuesParser;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use crate::image_out::{image_format, MAX_DIMENSION};
+
+/// Names accepted by `--scene`.
+pub const SCENES: [&str; 1] = ["cubes"];
+
+/// Largest `--threads` value accepted.
+pub const MAX_THREADS: usize = 1024;
+
+/// An exact fixed-point triangle rasterizer, desktop front end.
+#[derive(Parser, Debug, Clone)]
+#[command(name = "microraster", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands of `microraster`.
+#[derive(Subcommand, Debug, Clone)]
+pub enum Command {
+    /// Render a built-in scene, an OBJ mesh or clip-space triangles to an image.
+    Render(RenderArgs),
+}
+
+/// Which triangles face away and are skipped.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CullArg {
+    /// Skip back-facing triangles.
+    Back,
+    /// Skip front-facing triangles.
+    Front,
+    /// Draw every triangle.
+    None,
+}
+
+/// Depth buffer format.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthArg {
+    /// 16-bit depth buffer.
+    U16,
+    /// 32-bit depth buffer.
+    U32,
+    /// No depth buffer (painter's order).
+    None,
+}
+
+/// Where the triangles to render come from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// A built-in scene by name (one of [`SCENES`]).
+    Scene(String),
+    /// A Wavefront OBJ file.
+    Obj(PathBuf),
+    /// A `--clip-tris` text file.
+    ClipTris(PathBuf),
+}
+
+/// Options of `microraster render`.
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct RenderArgs {
+    /// Built-in scene to render.
+    #[arg(
+        long,
+        value_name = "NAME",
+        default_value = "cubes",
+        value_parser = PossibleValuesParser::new(SCENES),
+        conflicts_with_all = ["obj", "clip_tris"]
+    )]
+    pub scene: String,
+
+    /// Render this Wavefront OBJ mesh instead of a scene.
+    #[arg(long, value_name = "FILE")]
+    pub obj: Option<PathBuf>,
+
+    /// Render clip-space triangles from this text file (12 numbers per line,
+    /// optional r g b).
+    #[arg(long, value_name = "FILE", conflicts_with = "obj")]
+    pub clip_tris: Option<PathBuf>,
+
+    /// Camera position (default: the scene's, or framed to fit the OBJ).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<[f32; 3]>,
+
+    /// Point the camera looks at (default: the scene's, or the OBJ's centre).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<[f32; 3]>,
+
+    /// Vertical field of view in degrees.
+    #[arg(long, value_name = "DEG", default_value = "60", value_parser = parse_fov)]
+    pub fov: f32,
+
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "800x600", value_parser = parse_size)]
+    pub size: (u32, u32),
+
+    /// Worker threads.
+    #[arg(long, value_name = "N", default_value_t = default_threads(), value_parser = parse_threads)]
+    pub threads: usize,
+
+    /// Rows per strip.
+    #[arg(long, value_name = "R", default_value = "16", value_parser = parse_strip_rows)]
+    pub strip_rows: u32,
+
+    /// Face culling.
+    #[arg(long, value_enum, default_value_t = CullArg::Back)]
+    pub cull: CullArg,
+
+    /// Depth buffer format.
+    #[arg(long, value_enum, default_value_t = DepthArg::U32)]
+    pub depth: DepthArg,
+
+    /// Sub-pixel precision in bits (4 or 8).
+    #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
+    pub subpixel: u32,
+
+    /// Output image (.png or .ppm).
+    #[arg(long, value_name = "FILE", default_value = "cubes.png", value_parser = parse_image_path)]
+    pub out: PathBuf,
+
+    /// Also write the triangle-id image (RGBA PNG).
+    #[arg(long, value_name = "FILE", value_parser = parse_png_path)]
+    pub id_out: Option<PathBuf>,
+
+    /// Also write the raw depth buffer.
+    #[arg(long, value_name = "FILE")]
+    pub depth_out: Option<PathBuf>,
+
+    /// Print statistics as JSON.
+    #[arg(long)]
+    pub stats: bool,
+
+    /// Print a checksum of the image.
+    #[arg(long)]
+    pub checksum: bool,
+}
+
+impl RenderArgs {
+    /// Where the triangles come from: `--clip-tris`, else `--obj`, else the scene.
+    pub fn source(&self) -> Source {
+        if let Some(p) = &self.clip_tris {
+            Source::ClipTris(p.clone())
+        } else if let Some(p) = &self.obj {
+            Source::Obj(p.clone())
+        } else {
+            Source::Scene(self.scene.clone())
+        }
+    }
+
+    /// Image width in pixels.
+    pub fn width(&self) -> u32 {
+        self.size.0
+    }
+
+    /// Image height in pixels.
+    pub fn height(&self) -> u32 {
+        self.size.1
+    }
+
+    /// Width / height.
+    pub fn aspect(&self) -> f32 {
+        self.size.0 as f32 / self.size.1 as f32
+    }
+}
+
+/// Default for `--threads`: the machine's available parallelism, else 1.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .min(MAX_THREADS)
+}
+
+/// Parses `X,Y,Z` (three finite numbers, spaces around them allowed).
+pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers X,Y,Z, got {s:?}"
+        ));
+    }
+    let mut v = [0.0f32; 3];
+    for (dst, part) in v.iter_mut().zip(&parts) {
+        let x: f32 = part
+            .parse()
+            .map_err(|_| format!("cannot parse {part:?} as a number in {s:?}"))?;
+        if !x.is_finite() {
+            return Err(format!("{part:?} in {s:?} is not a finite number"));
+        }
+        *dst = x;
+    }
+    Ok(v)
+}
+
+/// Parses `WxH` (also `WXH`); each side must be in 1..=16384.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 800x600, got {s:?}"))?;
+    let side = |t: &str, name: &str| -> Result<u32, String> {
+        let n: u64 = t
+            .trim()
+            .parse()
+            .map_err(|_| format!("{name} {t:?} in {s:?} is not a whole number"))?;
+        if n == 0 || n > u64::from(MAX_DIMENSION) {
+            return Err(format!("{name} {n} must be in 1..={MAX_DIMENSION}"));
+        }
+        Ok(n as u32)
+    };
+    Ok((side(w, "width")?, side(h, "height")?))
+}
+
+/// Parses the vertical field of view in degrees: finite, strictly between 0 and 180.
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    let f: f32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("cannot parse {s:?} as a number of degrees"))?;
+    if !(f.is_finite() && f > 0.0 && f < 180.0) {
+        return Err(format!(
+            "field of view {s} must be between 0 and 180 degrees (exclusive)"
+        ));
+    }
+    Ok(f)
+}
+
+/// Parses a positive integer no larger than `max`.
+fn parse_count(s: &str, what: &str, max: u64) -> Result<u64, String> {
+    let n: u64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{what} {s:?} is not a whole number"))?;
+    if n == 0 || n > max {
+        return Err(format!("{what} must be in 1..={max}, got {n}"));
+    }
+    Ok(n)
+}
+
+/// Parses `--threads`: 1..=[`MAX_THREADS`].
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    parse_count(s, "thread count", MAX_THREADS as u64).map(|n| n as usize)
+}
+
+/// Parses `--strip-rows`: 1..=16384.
+pub fn parse_strip_rows(s: &str) -> Result<u32, String> {
+    parse_count(s, "strip rows", u64::from(MAX_DIMENSION)).map(|n| n as u32)
+}
+
+/// Parses `--subpixel`: 4 or 8.
+pub fn parse_subpixel(s: &str) -> Result<u32, String> {
+    match s.trim() {
+        "4" => Ok(4),
+        "8" => Ok(8),
+        _ => Err(format!("sub-pixel bits must be 4 or 8, got {s:?}")),
+    }
+}
+
+/// Parses an output image path: the extension must be `.png` or `.ppm`.
+pub fn parse_image_path(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    image_format(&p)?;
+    Ok(p)
+}
+
+/// Parses a PNG output path: the extension must be `.png`.
+pub fn parse_png_path(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    match image_format(&p) {
+        Ok(crate::image_out::ImageFormat::Png) => Ok(p),
+        _ => Err(format!(
+            "{s}: the triangle-id image is a PNG; use a .png extension"
+        )),
+    }
+}
+
+/// Checks that `eye`, `target` and `up` make a usable look-at camera: the eye
+/// differs from the target and the view direction is not parallel to `up`.
+pub fn check_camera(eye: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Result<(), String> {
+    let d = [0, 1, 2].map(|k| f64::from(target[k]) - f64::from(eye[k]));
+    let u = up.map(f64::from);
+    let len2 = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>();
+    let dd = len2(d);
+    if !dd.is_finite() || dd <= 0.0 {
+        return Err("the camera eye and target must be distinct finite points".to_string());
+    }
+    let c = [
+        d[1] * u[2] - d[2] * u[1],
+        d[2] * u[0] - d[0] * u[2],
+        d[0] * u[1] - d[1] * u[0],
+    ];
+    // |d x u|^2 = |d|^2 |u|^2 sin^2: parallel if sin is (almost) zero, and a
+    // zero or non-finite `up` fails the same test.
+    let cc = len2(c);
+    if !cc.is_finite() || cc <= 1e-12 * dd * len2(u) || len2(u) <= 0.0 {
+        return Err(format!(
+            "the view direction from {eye:?} to {target:?} is parallel to up {up:?}"
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn render(args: &[&str]) -> Result<RenderArgs, clap::Error> {
+        let mut argv = vec!["microraster", "render"];
+        argv.extend_from_slice(args);
+        Cli::try_parse_from(argv).map(|cli| match cli.command {
+            Command::Render(r) => r,
+        })
+    }
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn defaults() {
+        let r = render(&[]).unwrap();
+        assert_eq!(r.scene, "cubes");
+        assert_eq!(r.source(), Source::Scene("cubes".into()));
+        assert_eq!(r.obj, None);
+        assert_eq!(r.clip_tris, None);
+        assert_eq!(r.eye, None);
+        assert_eq!(r.target, None);
+        assert_eq!(r.fov, 60.0);
+        assert_eq!(r.size, (800, 600));
+        assert_eq!((r.width(), r.height()), (800, 600));
+        assert!((r.aspect() - 4.0 / 3.0).abs() < 1e-6);
+        assert_eq!(r.threads, default_threads());
+        assert!(r.threads >= 1);
+        assert_eq!(r.strip_rows, 16);
+        assert_eq!(r.cull, CullArg::Back);
+        assert_eq!(r.depth, DepthArg::U32);
+        assert_eq!(r.subpixel, 8);
+        assert_eq!(r.out, PathBuf::from("cubes.png"));
+        assert_eq!(r.id_out, None);
+        assert_eq!(r.depth_out, None);
+        assert!(!r.stats && !r.checksum);
+    }
+
+    #[test]
+    fn all_options() {
+        let r = render(&[
+            "--obj",
+            "m.obj",
+            "--eye",
+            "-1,2.5,3",
+            "--target=0, 0 ,-1e1",
+            "--fov",
+            "45.5",
+            "--size",
+            "640X480",
+            "--threads",
+            "3",
+            "--strip-rows",
+            "1",
+            "--cull",
+            "none",
+            "--depth",
+            "u16",
+            "--subpixel",
+            "4",
+            "--out",
+            "x.PPM",
+            "--id-out",
+            "ids.png",
+            "--depth-out",
+            "d.raw",
+            "--stats",
+            "--checksum",
+        ])
+        .unwrap();
+        assert_eq!(r.source(), Source::Obj("m.obj".into()));
+        assert_eq!(r.eye, Some([-1.0, 2.5, 3.0]));
+        assert_eq!(r.target, Some([0.0, 0.0, -10.0]));
+        assert_eq!(r.fov, 45.5);
+        assert_eq!(r.size, (640, 480));
+        assert_eq!(r.threads, 3);
+        assert_eq!(r.strip_rows, 1);
+        assert_eq!(r.cull, CullArg::None);
+        assert_eq!(r.depth, DepthArg::U16);
+        assert_eq!(r.subpixel, 4);
+        assert_eq!(r.out, PathBuf::from("x.PPM"));
+        assert_eq!(r.id_out, Some("ids.png".into()));
+        assert_eq!(r.depth_out, Some("d.raw".into()));
+        assert!(r.stats && r.checksum);
+
+        let r = render(&["--clip-tris", "t.txt", "--cull", "front", "--depth", "none"]).unwrap();
+        assert_eq!(r.source(), Source::ClipTris("t.txt".into()));
+        assert_eq!(r.cull, CullArg::Front);
+        assert_eq!(r.depth, DepthArg::None);
+        let r = render(&["--scene", "cubes", "--eye=-1,-2,-3"]).unwrap();
+        assert_eq!(r.eye, Some([-1.0, -2.0, -3.0]));
+    }
+
+    #[test]
+    fn bad_options_are_rejected() {
+        let bad: &[&[&str]] = &[
+            &["--obj", "a.obj", "--clip-tris", "b.txt"],
+            &["--scene", "cubes", "--obj", "a.obj"],
+            &["--scene", "teapot"],
+            &["--size", "0x600"],
+            &["--size", "800x0"],
+            &["--size", "16385x1"],
+            &["--size", "800"],
+            &["--size", "800x600x2"],
+            &["--size", "-800x600"],
+            &["--threads", "0"],
+            &["--threads", "-1"],
+            &["--threads", "many"],
+            &["--strip-rows", "0"],
+            &["--cull", "sideways"],
+            &["--depth", "f32"],
+            &["--subpixel", "6"],
+            &["--fov", "0"],
+            &["--fov", "180"],
+            &["--fov", "nan"],
+            &["--eye", "1,2"],
+            &["--eye", "1,2,nan"],
+            &["--target", "a,b,c"],
+            &["--out", "image.jpg"],
+            &["--out", "noext"],
+            &["--id-out", "ids.ppm"],
+            &["--bogus"],
+        ];
+        for args in bad {
+            assert!(render(args).is_err(), "accepted {args:?}");
+        }
+        assert!(Cli::try_parse_from(["microraster"]).is_err());
+        assert!(Cli::try_parse_from(["microraster", "paint"]).is_err());
+    }
+
+    #[test]
+    fn value_parsers() {
+        assert_eq!(parse_vec3("1,2,3"), Ok([1.0, 2.0, 3.0]));
+        assert_eq!(parse_vec3(" -1 , 0.5,1e2 "), Ok([-1.0, 0.5, 100.0]));
+        assert!(parse_vec3("1,2,3,4").is_err());
+        assert!(parse_vec3("").is_err());
+        assert!(parse_vec3("1,,3").is_err());
+        assert!(parse_vec3("inf,0,0").is_err());
+        assert_eq!(parse_size("1x1"), Ok((1, 1)));
+        assert_eq!(parse_size("16384x16384"), Ok((16384, 16384)));
+        assert!(parse_size("99999999999999999999x1").is_err());
+        assert!(parse_size("x").is_err());
+        assert!(parse_size("1.5x2").is_err());
+        let e = parse_size("0x5").unwrap_err();
+        assert!(e.contains("width") && e.contains("16384"), "{e}");
+        assert_eq!(parse_threads(&MAX_THREADS.to_string()), Ok(MAX_THREADS));
+        assert!(parse_threads(&(MAX_THREADS + 1).to_string()).is_err());
+        assert_eq!(parse_strip_rows("16"), Ok(16));
+        assert_eq!(parse_subpixel("8"), Ok(8));
+        assert!(parse_subpixel("16").is_err());
+        assert_eq!(parse_fov("179.9"), Ok(179.9));
+        assert!(parse_fov("-10").is_err());
+        assert!(parse_image_path("a.png").is_ok());
+        assert!(parse_image_path("a.gif").is_err());
+        assert!(parse_png_path("a.PNG").is_ok());
+        assert!(parse_png_path("a.ppm").is_err());
+    }
+
+    #[test]
+    fn camera_check() {
+        let up = [0.0, 1.0, 0.0];
+        assert!(check_camera([0.0, 3.75, 6.5], [0.0; 3], up).is_ok());
+        assert!(check_camera([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], up).is_err());
+        assert!(check_camera([0.0, 5.0, 0.0], [0.0; 3], up).is_err());
+        assert!(check_camera([0.0, -5.0, 0.0], [0.0; 3], up).is_err());
+        assert!(check_camera([f32::NAN, 0.0, 0.0], [0.0; 3], up).is_err());
+        assert!(check_camera([f32::MAX, 0.0, 0.0], [-f32::MAX, 0.0, 0.0], up).is_ok());
+        assert!(check_camera([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3]).is_err());
+    }
+}

@@ -1,0 +1,355 @@
+//! The default `cubes` scene, as plain data.
+//!
+//! Design: the scene is one unit cube mesh (corners at ±1) drawn four times
+//! with different model transforms, seen by a fixed camera. It is kept as
+//! plain arrays (no core types) so the host can feed it to whatever API the
+//! core offers and tests can check the geometry independently.
+//!
+//! Triangles come in coplanar pairs, one pair per cube face; [`TRIANGLE_FACE`]
+//! maps a triangle to its face and [`FACE_COLORS`] gives each face a colour
+//! (the Okabe–Ito colour-blind-safe palette). Every triangle winds
+//! counter-clockwise seen from outside the cube (right-hand-rule normal points
+//! away from the centre); see [`CUBE_FRONT_FACE_CCW`].
+//!
+//! Model transforms are listed in the order they are applied to a vertex: for
+//! `[Translate(t), RotateYDeg(a)]` the vertex is translated first and then
+//! rotated about the origin, i.e. the model matrix is `M = R * T` acting on
+//! column vectors `M * [x, y, z, 1]`. Rotations are right-handed: a positive
+//! angle turns counter-clockwise when looking from the positive axis towards
+//! the origin (e.g. `RotateZDeg(90)` maps +x to +y).
+
+/// Cube corner positions (model space).
+pub const CUBE_VERTICES: [[f32; 3]; 8] = [
+    [1.0, -1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [-1.0, -1.0, 1.0],
+    [-1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+    [-1.0, 1.0, -1.0],
+];
+
+/// Cube triangles as indices into [`CUBE_VERTICES`].
+pub const CUBE_INDICES: [[u32; 3]; 12] = [
+    [1, 3, 0],
+    [7, 5, 4],
+    [4, 1, 0],
+    [5, 2, 1],
+    [2, 7, 3],
+    [0, 7, 4],
+    [1, 2, 3],
+    [7, 6, 5],
+    [4, 5, 1],
+    [5, 6, 2],
+    [2, 6, 7],
+    [0, 3, 7],
+];
+
+/// Number of cube faces.
+pub const FACE_COUNT: usize = 6;
+
+/// Face of each triangle in [`CUBE_INDICES`] (an index into [`FACE_COLORS`],
+/// [`FACE_NAMES`] and [`FACE_NORMALS`]). Triangles `i` and `i + 6` share a face.
+pub const TRIANGLE_FACE: [usize; 12] = [0, 1, 2, 3, 4, 5, 0, 1, 2, 3, 4, 5];
+
+/// Human-readable plane of each face.
+pub const FACE_NAMES: [&str; FACE_COUNT] = ["y=-1", "y=+1", "x=+1", "z=+1", "x=-1", "z=-1"];
+
+/// Outward unit normal of each face (model space).
+pub const FACE_NORMALS: [[f32; 3]; FACE_COUNT] = [
+    [0.0, -1.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, 0.0, -1.0],
+];
+
+/// One colour per face (Okabe–Ito palette).
+pub const FACE_COLORS: [[u8; 3]; FACE_COUNT] = [
+    [230, 159, 0],   // y=-1: orange
+    [86, 180, 233],  // y=+1: sky blue
+    [0, 158, 115],   // x=+1: bluish green
+    [240, 228, 66],  // z=+1: yellow
+    [0, 114, 178],   // x=-1: blue
+    [204, 121, 167], // z=-1: reddish purple
+];
+
+/// Face of triangle `tri_index` of the cube, or `None` past the 12 triangles.
+pub fn triangle_face(tri_index: usize) -> Option<usize> {
+    TRIANGLE_FACE.get(tri_index).copied()
+}
+
+/// Colour of triangle `tri_index` of the cube, or `None` past the 12 triangles.
+pub fn triangle_color(tri_index: usize) -> Option<[u8; 3]> {
+    triangle_face(tri_index).map(|f| FACE_COLORS[f])
+}
+
+/// `true`: every cube triangle is counter-clockwise seen from outside, so with
+/// a counter-clockwise front-face convention back-face culling removes the
+/// hidden faces (verified by a test).
+pub const CUBE_FRONT_FACE_CCW: bool = true;
+
+/// One step of a model transform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Op {
+    /// Add the vector to the position.
+    Translate([f32; 3]),
+    /// Rotate about the x axis by the angle in degrees (right-handed).
+    RotateXDeg(f32),
+    /// Rotate about the y axis by the angle in degrees (right-handed).
+    RotateYDeg(f32),
+    /// Rotate about the z axis by the angle in degrees (right-handed).
+    RotateZDeg(f32),
+}
+
+impl Op {
+    /// This step as a row-major 4x4 matrix acting on column vectors
+    /// (`m[row][col]`, translation in the last column).
+    pub fn matrix(self) -> [[f32; 4]; 4] {
+        let rot = |deg: f32| deg.to_radians().sin_cos();
+        match self {
+            Op::Translate([x, y, z]) => [
+                [1.0, 0.0, 0.0, x],
+                [0.0, 1.0, 0.0, y],
+                [0.0, 0.0, 1.0, z],
+                [0.0, 0.0, 0.0, 1.0],
+            ],
+            Op::RotateXDeg(a) => {
+                let (s, c) = rot(a);
+                [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, c, -s, 0.0],
+                    [0.0, s, c, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            }
+            Op::RotateYDeg(a) => {
+                let (s, c) = rot(a);
+                [
+                    [c, 0.0, s, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [-s, 0.0, c, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            }
+            Op::RotateZDeg(a) => {
+                let (s, c) = rot(a);
+                [
+                    [c, -s, 0.0, 0.0],
+                    [s, c, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ]
+            }
+        }
+    }
+
+    /// Applies this step to a point.
+    pub fn apply(self, p: [f32; 3]) -> [f32; 3] {
+        let m = self.matrix();
+        [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+    }
+}
+
+/// The model matrix of `ops` applied in order (first op first), i.e.
+/// `ops[n-1] * ... * ops[1] * ops[0]`, row-major, acting on column vectors.
+pub fn model_matrix(ops: &[Op]) -> [[f32; 4]; 4] {
+    let mut m = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    for op in ops {
+        let a = op.matrix();
+        let mut out = [[0.0f32; 4]; 4];
+        for (r, row) in out.iter_mut().enumerate() {
+            for (c, cell) in row.iter_mut().enumerate() {
+                *cell = (0..4).map(|k| a[r][k] * m[k][c]).sum();
+            }
+        }
+        m = out;
+    }
+    m
+}
+
+/// Applies `ops` to a point in order (first op first).
+pub fn transform_point(ops: &[Op], p: [f32; 3]) -> [f32; 3] {
+    ops.iter().fold(p, |q, op| op.apply(q))
+}
+
+/// The four cube instances: each is translated, then rotated about the origin.
+pub const CUBE_MODELS: [[Op; 2]; 4] = [
+    [Op::Translate([0.0, 0.0, 2.0]), Op::RotateYDeg(45.0)],
+    [Op::Translate([-3.75, 0.0, 0.0]), Op::RotateXDeg(30.0)],
+    [Op::Translate([3.75, 0.0, 0.0]), Op::RotateYDeg(60.0)],
+    [Op::Translate([0.0, 0.0, -2.0]), Op::RotateZDeg(90.0)],
+];
+
+/// Camera position.
+pub const CUBES_EYE: [f32; 3] = [0.0, 3.75, 6.5];
+/// Point the camera looks at.
+pub const CUBES_TARGET: [f32; 3] = [0.0, 0.0, 0.0];
+/// Camera up direction.
+pub const CUBES_UP: [f32; 3] = [0.0, 1.0, 0.0];
+/// Vertical field of view in degrees.
+pub const CUBES_FOV_Y_DEG: f32 = 60.0;
+/// Near clipping plane distance.
+pub const CUBES_NEAR: f32 = 0.1;
+/// Far clipping plane distance.
+pub const CUBES_FAR: f32 = 100.0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+    fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
+    fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+    fn tri(t: usize) -> [[f32; 3]; 3] {
+        CUBE_INDICES[t].map(|i| CUBE_VERTICES[i as usize])
+    }
+    fn close(a: [f32; 3], b: [f32; 3]) -> bool {
+        (0..3).all(|k| (a[k] - b[k]).abs() < 1e-5)
+    }
+
+    #[test]
+    fn triangle_faces_are_coplanar_pairs() {
+        for (t, &f) in TRIANGLE_FACE.iter().enumerate() {
+            let n = FACE_NORMALS[f];
+            // All three vertices lie on the face plane n·p = 1.
+            for p in tri(t) {
+                assert_eq!(
+                    dot(n, p),
+                    1.0,
+                    "triangle {t} vertex {p:?} not on {}",
+                    FACE_NAMES[f]
+                );
+            }
+        }
+        // Each face has exactly two triangles, and together they use its 4 corners.
+        for f in 0..FACE_COUNT {
+            let tris: Vec<usize> = (0..12).filter(|&t| TRIANGLE_FACE[t] == f).collect();
+            assert_eq!(tris.len(), 2, "face {f}");
+            let mut corners: Vec<u32> = tris.iter().flat_map(|&t| CUBE_INDICES[t]).collect();
+            corners.sort_unstable();
+            corners.dedup();
+            assert_eq!(corners.len(), 4, "face {f}");
+        }
+        assert_eq!(triangle_face(11), Some(5));
+        assert_eq!(triangle_face(12), None);
+        assert_eq!(triangle_color(0), Some(FACE_COLORS[0]));
+        assert_eq!(triangle_color(99), None);
+    }
+
+    #[test]
+    fn triangles_wind_ccw_from_outside() {
+        let mut all_ccw = true;
+        for t in 0..12 {
+            let [a, b, c] = tri(t);
+            let n = cross(sub(b, a), sub(c, a));
+            let centroid = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+            // Cube centre is the origin.
+            let outward = dot(n, centroid) > 0.0;
+            all_ccw &= outward;
+            // Normal is along the face normal either way.
+            let face_n = FACE_NORMALS[TRIANGLE_FACE[t]];
+            assert!(close(cross(n, face_n), [0.0; 3]), "triangle {t}");
+        }
+        assert_eq!(all_ccw, CUBE_FRONT_FACE_CCW);
+    }
+
+    #[test]
+    fn face_colors_are_distinct() {
+        for (i, a) in FACE_COLORS.iter().enumerate() {
+            for b in &FACE_COLORS[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+    }
+
+    #[test]
+    fn rotations_are_right_handed() {
+        assert!(close(
+            Op::RotateZDeg(90.0).apply([1.0, 0.0, 0.0]),
+            [0.0, 1.0, 0.0]
+        ));
+        assert!(close(
+            Op::RotateXDeg(90.0).apply([0.0, 1.0, 0.0]),
+            [0.0, 0.0, 1.0]
+        ));
+        assert!(close(
+            Op::RotateYDeg(90.0).apply([0.0, 0.0, 1.0]),
+            [1.0, 0.0, 0.0]
+        ));
+        assert!(close(
+            Op::Translate([1.0, 2.0, 3.0]).apply([1.0, 1.0, 1.0]),
+            [2.0, 3.0, 4.0]
+        ));
+    }
+
+    #[test]
+    fn translate_then_rotate() {
+        // Cube 4: translate (0,0,-2) then rotate 90° about z: the centre stays at
+        // (0,0,-2) and the corner (1,-1,-1) goes to (1,-1,-3) then to (1,1,-3).
+        let ops = &CUBE_MODELS[3];
+        assert!(close(transform_point(ops, [0.0; 3]), [0.0, 0.0, -2.0]));
+        assert!(close(
+            transform_point(ops, [1.0, -1.0, -1.0]),
+            [1.0, 1.0, -3.0]
+        ));
+        // Cube 1: the centre (0,0,2) rotates 45° about y onto (√2, 0, √2).
+        let h = std::f32::consts::SQRT_2;
+        assert!(close(
+            transform_point(&CUBE_MODELS[0], [0.0; 3]),
+            [h, 0.0, h]
+        ));
+        // Cube 2: the centre stays on the x axis (rotation about x).
+        assert!(close(
+            transform_point(&CUBE_MODELS[1], [0.0; 3]),
+            [-3.75, 0.0, 0.0]
+        ));
+        // model_matrix agrees with applying the ops in order (M = R * T).
+        for ops in &CUBE_MODELS {
+            let m = model_matrix(ops);
+            assert_eq!(m[3], [0.0, 0.0, 0.0, 1.0]);
+            for p in CUBE_VERTICES {
+                let q =
+                    [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
+                assert!(close(q, transform_point(ops, p)));
+            }
+        }
+    }
+
+    #[test]
+    fn camera_constants_are_sane() {
+        let view = sub(CUBES_TARGET, CUBES_EYE);
+        assert!(dot(view, view) > 0.0);
+        assert!(cross(view, CUBES_UP) != [0.0; 3]);
+        const { assert!(CUBES_NEAR > 0.0 && CUBES_FAR > CUBES_NEAR) };
+        const { assert!(CUBES_FOV_Y_DEG > 0.0 && CUBES_FOV_Y_DEG < 180.0) };
+        // Every transformed cube lies in front of the camera, between near and far.
+        let fwd = {
+            let l = dot(view, view).sqrt();
+            view.map(|c| c / l)
+        };
+        for ops in &CUBE_MODELS {
+            for p in CUBE_VERTICES {
+                let d = dot(sub(transform_point(ops, p), CUBES_EYE), fwd);
+                assert!(d > CUBES_NEAR && d < CUBES_FAR);
+            }
+        }
+    }
+}
