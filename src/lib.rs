@@ -65,3 +65,8 @@ pub use setup::SetupTriangle;
 
 /// Colour types from embedded-graphics, re-exported for convenience.
 pub use embedded_graphics_core::pixelcolor;
+
+/// The README's code examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
