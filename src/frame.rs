@@ -176,7 +176,7 @@ pub struct Stats {
 }
 
 impl Stats {
-    fn add(&mut self, o: &Stats) {
+    pub(crate) fn add(&mut self, o: &Stats) {
         self.submitted += o.submitted;
         self.culled_object += o.culled_object;
         self.culled_frustum += o.culled_frustum;
@@ -279,7 +279,30 @@ pub struct Mesh<'a> {
     pub bounds: Option<BoundingSphere>,
 }
 
-fn rgb_f32(c: Rgb888) -> [f32; 3] {
+impl Mesh<'_> {
+    /// Triangle `i` transformed to clip space by `mvp`, with its colours;
+    /// `None` if an index (or a colour) is out of range.
+    pub fn triangle(&self, i: usize, mvp: &Mat4) -> Option<[ClipVertex; 3]> {
+        let idx = self.indices.get(i)?;
+        let mut verts = [ClipVertex::default(); 3];
+        for k in 0..3 {
+            let vi = idx[k] as usize;
+            let p = self.positions.get(vi)?;
+            let color = match self.colors {
+                MeshColors::Uniform(c) => c,
+                MeshColors::PerTriangle(cs) => *cs.get(i)?,
+                MeshColors::PerVertex(cs) => *cs.get(vi)?,
+            };
+            verts[k] = ClipVertex {
+                pos: mvp.transform_point(*p),
+                color: rgb_f32(color),
+            };
+        }
+        Some(verts)
+    }
+}
+
+pub(crate) fn rgb_f32(c: Rgb888) -> [f32; 3] {
     [c.r() as f32, c.g() as f32, c.b() as f32]
 }
 
@@ -328,13 +351,7 @@ impl<'s, const S: u32> Frame<'s, S> {
     pub fn new(config: Config, storage: &'s mut [SetupTriangle]) -> Result<Self, Error> {
         #[allow(clippy::let_unit_value)]
         let () = Self::SUBPIXEL_OK;
-        let ok = |v: u32| (1..=MAX_DIMENSION).contains(&v);
-        if !ok(config.width) || !ok(config.height) {
-            return Err(Error::InvalidFrameSize {
-                width: config.width,
-                height: config.height,
-            });
-        }
+        check_size(&config)?;
         Ok(Frame {
             config,
             guard: guard_band_ndc::<S>(config.width, config.height),
@@ -405,7 +422,7 @@ impl<'s, const S: u32> Frame<'s, S> {
             ..Stats::default()
         };
         let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
-        self.process(&tri, id, &mut stats, &mut out);
+        process::<S>(&self.config, self.guard, &tri, id, &mut stats, &mut out);
         let free = self.storage.len() - self.len;
         if out.len() > free {
             return Err(Error::StorageFull {
@@ -439,35 +456,13 @@ impl<'s, const S: u32> Frame<'s, S> {
         }
         let start_len = self.len;
         let start_stats = self.stats;
-        for (i, idx) in mesh.indices.iter().enumerate() {
+        for i in 0..mesh.indices.len() {
             let id = first_id.wrapping_add(i as u32);
-            let mut verts = [ClipVertex::default(); 3];
-            let mut valid = true;
-            for k in 0..3 {
-                let vi = idx[k] as usize;
-                let Some(p) = mesh.positions.get(vi) else {
-                    valid = false;
-                    break;
-                };
-                let color = match mesh.colors {
-                    MeshColors::Uniform(c) => Some(c),
-                    MeshColors::PerTriangle(cs) => cs.get(i).copied(),
-                    MeshColors::PerVertex(cs) => cs.get(vi).copied(),
-                };
-                let Some(color) = color else {
-                    valid = false;
-                    break;
-                };
-                verts[k] = ClipVertex {
-                    pos: mvp.transform_point(*p),
-                    color: rgb_f32(color),
-                };
-            }
-            if !valid {
+            let Some(verts) = mesh.triangle(i, mvp) else {
                 self.stats.submitted += 1;
                 self.stats.rejected_index += 1;
                 continue;
-            }
+            };
             if let Err(e) = self.push_triangle(verts, id) {
                 self.len = start_len;
                 self.stats = start_stats;
@@ -483,70 +478,6 @@ impl<'s, const S: u32> Frame<'s, S> {
         Ok(())
     }
 
-    /// Runs one triangle through cull, clip and setup into `out`.
-    fn process(
-        &self,
-        tri: &[ClipVertex; 3],
-        id: u32,
-        stats: &mut Stats,
-        out: &mut heapless::Vec<SetupTriangle, 7>,
-    ) {
-        if !tri
-            .iter()
-            .all(|v| v.pos.is_finite() && v.color.iter().all(|c| c.is_finite()))
-        {
-            stats.rejected_nonfinite += 1;
-            return;
-        }
-        let (gx, gy) = self.guard;
-        let codes = [
-            outcode(tri[0].pos, gx, gy),
-            outcode(tri[1].pos, gx, gy),
-            outcode(tri[2].pos, gx, gy),
-        ];
-        if codes[0] & codes[1] & codes[2] & outcode::FRUSTUM != 0 {
-            stats.culled_frustum += 1;
-            return;
-        }
-        let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
-        let c = &self.config;
-        if crossing == 0 {
-            match setup::<S>(tri, c.width, c.height, c.cull, c.front_face, id) {
-                Ok(t) => {
-                    let _ = out.push(t);
-                    stats.stored += 1;
-                }
-                Err(r) => count_rejected(stats, r),
-            }
-            return;
-        }
-        stats.clipped += 1;
-        let poly = clip_triangle(tri, crossing, gx, gy);
-        if poly.len() < 3 {
-            stats.culled_frustum += 1;
-            return;
-        }
-        // Fan from vertex 0; each piece is culled and set up on its own
-        // (all pieces share the winding of the input triangle).
-        let mut first_reason = None;
-        for i in 1..poly.len() - 1 {
-            let piece = [poly[0], poly[i], poly[i + 1]];
-            match setup::<S>(&piece, c.width, c.height, c.cull, c.front_face, id) {
-                Ok(t) => {
-                    // At most 7 pieces from a 9-gon: cannot fail.
-                    let _ = out.push(t);
-                    stats.stored += 1;
-                }
-                Err(r) => {
-                    first_reason.get_or_insert(r);
-                }
-            }
-        }
-        if out.is_empty() {
-            count_rejected(stats, first_reason.unwrap_or(Rejected::Degenerate));
-        }
-    }
-
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which
     /// hold exactly those rows (`width * (y1 - y0)` values, row `y0`
     /// first). Pass `&mut NoDepth` to draw without a depth buffer. The
@@ -558,22 +489,8 @@ impl<'s, const S: u32> Frame<'s, S> {
         color: &mut [C],
         depth: &mut D,
     ) -> Result<RenderStats, Error> {
-        let Config { width, height, .. } = self.config;
-        if y0 >= y1 || y1 > height {
-            return Err(Error::InvalidRows { y0, y1, height });
-        }
-        let expected = width as usize * (y1 - y0) as usize;
-        if color.len() != expected {
-            return Err(Error::ColorBufferSize {
-                expected,
-                actual: color.len(),
-            });
-        }
-        if let Some(actual) = depth.depth_len() {
-            if actual != expected {
-                return Err(Error::DepthBufferSize { expected, actual });
-            }
-        }
+        check_rows(&self.config, y0, y1, color.len(), depth.depth_len())?;
+        let width = self.config.width;
         let mut strip = Strip {
             width: width as usize,
             y0,
@@ -597,5 +514,109 @@ fn count_rejected(stats: &mut Stats, r: Rejected) {
         Rejected::Degenerate => stats.culled_degenerate += 1,
         Rejected::Offscreen => stats.culled_frustum += 1,
         Rejected::NonFinite => stats.rejected_nonfinite += 1,
+    }
+}
+
+/// Runs one triangle through cull, clip and setup into `out`.
+pub(crate) fn process<const S: u32>(
+    c: &Config,
+    guard: (f32, f32),
+    tri: &[ClipVertex; 3],
+    id: u32,
+    stats: &mut Stats,
+    out: &mut heapless::Vec<SetupTriangle, 7>,
+) {
+    if !tri
+        .iter()
+        .all(|v| v.pos.is_finite() && v.color.iter().all(|c| c.is_finite()))
+    {
+        stats.rejected_nonfinite += 1;
+        return;
+    }
+    let (gx, gy) = guard;
+    let codes = [
+        outcode(tri[0].pos, gx, gy),
+        outcode(tri[1].pos, gx, gy),
+        outcode(tri[2].pos, gx, gy),
+    ];
+    if codes[0] & codes[1] & codes[2] & outcode::FRUSTUM != 0 {
+        stats.culled_frustum += 1;
+        return;
+    }
+    let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
+    if crossing == 0 {
+        match setup::<S>(tri, c.width, c.height, c.cull, c.front_face, id) {
+            Ok(t) => {
+                let _ = out.push(t);
+                stats.stored += 1;
+            }
+            Err(r) => count_rejected(stats, r),
+        }
+        return;
+    }
+    stats.clipped += 1;
+    let poly = clip_triangle(tri, crossing, gx, gy);
+    if poly.len() < 3 {
+        stats.culled_frustum += 1;
+        return;
+    }
+    // Fan from vertex 0; each piece is culled and set up on its own
+    // (all pieces share the winding of the input triangle).
+    let mut first_reason = None;
+    for i in 1..poly.len() - 1 {
+        let piece = [poly[0], poly[i], poly[i + 1]];
+        match setup::<S>(&piece, c.width, c.height, c.cull, c.front_face, id) {
+            Ok(t) => {
+                // At most 7 pieces from a 9-gon: cannot fail.
+                let _ = out.push(t);
+                stats.stored += 1;
+            }
+            Err(r) => {
+                first_reason.get_or_insert(r);
+            }
+        }
+    }
+    if out.is_empty() {
+        count_rejected(stats, first_reason.unwrap_or(Rejected::Degenerate));
+    }
+}
+
+/// Checks a row range and buffer sizes against a frame.
+pub(crate) fn check_rows(
+    config: &Config,
+    y0: u32,
+    y1: u32,
+    color_len: usize,
+    depth_len: Option<usize>,
+) -> Result<(), Error> {
+    let Config { width, height, .. } = *config;
+    if y0 >= y1 || y1 > height {
+        return Err(Error::InvalidRows { y0, y1, height });
+    }
+    let expected = width as usize * (y1 - y0) as usize;
+    if color_len != expected {
+        return Err(Error::ColorBufferSize {
+            expected,
+            actual: color_len,
+        });
+    }
+    if let Some(actual) = depth_len {
+        if actual != expected {
+            return Err(Error::DepthBufferSize { expected, actual });
+        }
+    }
+    Ok(())
+}
+
+/// Checks a frame size.
+pub(crate) fn check_size(config: &Config) -> Result<(), Error> {
+    let ok = |v: u32| (1..=MAX_DIMENSION).contains(&v);
+    if ok(config.width) && ok(config.height) {
+        Ok(())
+    } else {
+        Err(Error::InvalidFrameSize {
+            width: config.width,
+            height: config.height,
+        })
     }
 }

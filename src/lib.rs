@@ -49,6 +49,7 @@ mod color;
 mod depth;
 pub mod fixed;
 mod frame;
+mod immediate;
 pub mod math;
 mod raster;
 mod setup;
@@ -60,6 +61,7 @@ pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
 pub use frame::{
     BoundingSphere, Config, CullMode, Error, Frame, FrontFace, Mesh, MeshColors, RenderStats, Stats,
 };
+pub use immediate::StripRenderer;
 pub use math::{Mat4, Vec3, Vec4};
 pub use setup::SetupTriangle;
 
