@@ -32,8 +32,6 @@
 //! | 8 | 1/256 px | 16384 x 16384 | ±2^19 = ±524,288 |
 //! | 4 | 1/16 px | 16384 x 16384 | ±2^23 = ±8,388,608 |
 
-use crate::math::fx;
-
 /// The default number of subpixel bits (1/256 pixel).
 pub const SUBPIXEL_BITS: u32 = 8;
 
@@ -73,14 +71,21 @@ pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
 
 /// Rounds `v` to the nearest integer (halves up) and checks the result is
 /// within `±COORD_LIMIT`. `None` for NaN, infinities and out-of-range values.
+///
+/// No float function is involved: `t = v + 0.5` is truncated by `as` and
+/// corrected by one where truncation went up (negative `t`), so the result
+/// is `floor(v + 0.5)` on every target and with either float backend.
 #[inline]
 fn round_to_coord(v: f32) -> Option<i32> {
-    let r = fx::floor(v + 0.5);
-    if r.is_finite() && r.abs() <= COORD_LIMIT as f32 {
-        Some(r as i32)
-    } else {
-        None
+    let t = v + 0.5;
+    if !(t.is_finite() && t.abs() <= COORD_LIMIT as f32) {
+        return None;
     }
+    let mut i = t as i32;
+    if (i as f32) > t {
+        i -= 1;
+    }
+    Some(i)
 }
 
 /// Snaps a clip-space position to window space at `S` subpixel bits.

@@ -4,63 +4,96 @@
 //! order of operations, with no fused multiply-add (Rust never contracts
 //! `a * b + c` on its own), so the host and a Cortex-M build compute the same
 //! bits. Transcendental functions (`sin`, `cos`, `tan`, `sqrt`, `floor`) go
-//! through the one shim at the top of this file, chosen by cargo feature:
-//! `libm` (default, correctly rounded or close to it) or `micromath` (fast
-//! approximations). Nothing here decides coverage: the only float that
+//! through the [`FloatFns`] backends at the top of this file, chosen by cargo
+//! feature: `libm` (default, correctly rounded or close to it) or `micromath`
+//! (fast approximations). Nothing here decides coverage: the only float that
 //! reaches the rasterizer is rounded to a named fixed-point format in
 //! [`crate::fixed`] first.
 
 #[cfg(not(any(feature = "libm", feature = "micromath")))]
 compile_error!("microraster needs a float backend: enable feature `libm` (default) or `micromath`");
 
-/// The float shim: one place where the math backend is chosen.
+/// The float functions the vertex stage needs, from one backend.
+///
+/// [`Libm`] and [`Micromath`] implement it, each behind its cargo feature;
+/// [`DefaultFloat`] is the one the plain constructors ([`Mat4::perspective`]
+/// and friends) use: `libm` when that feature is on, else `micromath`. Both
+/// may be enabled at once, and the `*_with` constructors pick one
+/// explicitly (the host's speed-vs-error report compares them in one run).
+pub trait FloatFns {
+    /// Sine.
+    fn sin(x: f32) -> f32;
+    /// Cosine.
+    fn cos(x: f32) -> f32;
+    /// Tangent.
+    fn tan(x: f32) -> f32;
+    /// Square root.
+    fn sqrt(x: f32) -> f32;
+}
+
+/// Accurate float functions from the `libm` crate.
 #[cfg(feature = "libm")]
-pub(crate) mod fx {
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Libm;
+
+#[cfg(feature = "libm")]
+impl FloatFns for Libm {
     #[inline]
-    pub fn sin(x: f32) -> f32 {
+    fn sin(x: f32) -> f32 {
         libm::sinf(x)
     }
     #[inline]
-    pub fn cos(x: f32) -> f32 {
+    fn cos(x: f32) -> f32 {
         libm::cosf(x)
     }
     #[inline]
-    pub fn tan(x: f32) -> f32 {
+    fn tan(x: f32) -> f32 {
         libm::tanf(x)
     }
     #[inline]
-    pub fn sqrt(x: f32) -> f32 {
+    fn sqrt(x: f32) -> f32 {
         libm::sqrtf(x)
-    }
-    #[inline]
-    pub fn floor(x: f32) -> f32 {
-        libm::floorf(x)
     }
 }
 
-/// The float shim: one place where the math backend is chosen.
+/// Fast approximate float functions from the `micromath` crate.
+#[cfg(feature = "micromath")]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Micromath;
+
+#[cfg(feature = "micromath")]
+impl FloatFns for Micromath {
+    #[inline]
+    fn sin(x: f32) -> f32 {
+        micromath::F32Ext::sin(x)
+    }
+    #[inline]
+    fn cos(x: f32) -> f32 {
+        micromath::F32Ext::cos(x)
+    }
+    #[inline]
+    fn tan(x: f32) -> f32 {
+        micromath::F32Ext::tan(x)
+    }
+    #[inline]
+    fn sqrt(x: f32) -> f32 {
+        micromath::F32Ext::sqrt(x)
+    }
+}
+
+/// The backend chosen by cargo feature (`libm` wins if both are on).
+#[cfg(feature = "libm")]
+pub type DefaultFloat = Libm;
+/// The backend chosen by cargo feature (`libm` wins if both are on).
 #[cfg(all(feature = "micromath", not(feature = "libm")))]
+pub type DefaultFloat = Micromath;
+
+/// The float shim used inside the crate.
 pub(crate) mod fx {
-    use micromath::F32Ext;
-    #[inline]
-    pub fn sin(x: f32) -> f32 {
-        x.sin()
-    }
-    #[inline]
-    pub fn cos(x: f32) -> f32 {
-        x.cos()
-    }
-    #[inline]
-    pub fn tan(x: f32) -> f32 {
-        x.tan()
-    }
+    use super::{DefaultFloat, FloatFns};
     #[inline]
     pub fn sqrt(x: f32) -> f32 {
-        x.sqrt()
-    }
-    #[inline]
-    pub fn floor(x: f32) -> f32 {
-        x.floor()
+        DefaultFloat::sqrt(x)
     }
 }
 
@@ -112,7 +145,12 @@ impl Vec3 {
 
     /// This vector scaled to unit length; the zero vector stays zero.
     pub fn normalize(self) -> Vec3 {
-        let len = self.length();
+        self.normalize_with::<DefaultFloat>()
+    }
+
+    /// [`Vec3::normalize`] with the float backend `F`.
+    pub fn normalize_with<F: FloatFns>(self) -> Vec3 {
+        let len = F::sqrt(self.dot(self));
         if len > 0.0 {
             self * (1.0 / len)
         } else {
@@ -268,7 +306,12 @@ impl Mat4 {
 
     /// A right-handed rotation by `radians` about the x axis.
     pub fn rotation_x(radians: f32) -> Mat4 {
-        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::rotation_x_with::<DefaultFloat>(radians)
+    }
+
+    /// [`Mat4::rotation_x`] with the float backend `F`.
+    pub fn rotation_x_with<F: FloatFns>(radians: f32) -> Mat4 {
+        let (s, c) = (F::sin(radians), F::cos(radians));
         Mat4::from_rows([
             [1.0, 0.0, 0.0, 0.0],
             [0.0, c, -s, 0.0],
@@ -279,7 +322,12 @@ impl Mat4 {
 
     /// A right-handed rotation by `radians` about the y axis.
     pub fn rotation_y(radians: f32) -> Mat4 {
-        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::rotation_y_with::<DefaultFloat>(radians)
+    }
+
+    /// [`Mat4::rotation_y`] with the float backend `F`.
+    pub fn rotation_y_with<F: FloatFns>(radians: f32) -> Mat4 {
+        let (s, c) = (F::sin(radians), F::cos(radians));
         Mat4::from_rows([
             [c, 0.0, s, 0.0],
             [0.0, 1.0, 0.0, 0.0],
@@ -290,7 +338,12 @@ impl Mat4 {
 
     /// A right-handed rotation by `radians` about the z axis.
     pub fn rotation_z(radians: f32) -> Mat4 {
-        let (s, c) = (fx::sin(radians), fx::cos(radians));
+        Mat4::rotation_z_with::<DefaultFloat>(radians)
+    }
+
+    /// [`Mat4::rotation_z`] with the float backend `F`.
+    pub fn rotation_z_with<F: FloatFns>(radians: f32) -> Mat4 {
+        let (s, c) = (F::sin(radians), F::cos(radians));
         Mat4::from_rows([
             [c, -s, 0.0, 0.0],
             [s, c, 0.0, 0.0],
@@ -302,7 +355,17 @@ impl Mat4 {
     /// An OpenGL perspective projection (right-handed eye space looking down
     /// -z, clip z in `[-w, w]`), like `gluPerspective`.
     pub fn perspective(fov_y_radians: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
-        let f = 1.0 / fx::tan(fov_y_radians * 0.5);
+        Mat4::perspective_with::<DefaultFloat>(fov_y_radians, aspect, near, far)
+    }
+
+    /// [`Mat4::perspective`] with the float backend `F`.
+    pub fn perspective_with<F: FloatFns>(
+        fov_y_radians: f32,
+        aspect: f32,
+        near: f32,
+        far: f32,
+    ) -> Mat4 {
+        let f = 1.0 / F::tan(fov_y_radians * 0.5);
         let nf = 1.0 / (near - far);
         Mat4::from_rows([
             [f / aspect, 0.0, 0.0, 0.0],
@@ -315,8 +378,13 @@ impl Mat4 {
     /// A right-handed view matrix looking from `eye` at `target`, like
     /// `gluLookAt`.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
-        let f = (target - eye).normalize();
-        let s = f.cross(up).normalize();
+        Mat4::look_at_with::<DefaultFloat>(eye, target, up)
+    }
+
+    /// [`Mat4::look_at`] with the float backend `F`.
+    pub fn look_at_with<F: FloatFns>(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
+        let f = (target - eye).normalize_with::<F>();
+        let s = f.cross(up).normalize_with::<F>();
         let u = s.cross(f);
         Mat4::from_rows([
             [s.x, s.y, s.z, -s.dot(eye)],
