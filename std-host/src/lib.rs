@@ -13,11 +13,13 @@
 
 pub mod cli;
 pub mod cliptris;
-pub mod cubes;
 pub mod image_out;
 pub mod json;
 pub mod obj;
 pub mod render;
+
+/// The default scene's data, from the shared no_std scenes crate.
+pub use microraster_scenes::cubes;
 
 #[cfg(test)]
 pub(crate) mod test_util {

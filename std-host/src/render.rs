@@ -60,47 +60,23 @@ fn v3(a: [f32; 3]) -> Vec3 {
 }
 
 /// The default scene: four cubes, a colour per face, camera at
-/// (0, 3.75, 6.5) looking at the origin, 60° vertical field of view.
+/// (0, 3.75, 6.5) looking at the origin, 60° vertical field of view (see
+/// [`crate::cubes`]).
 pub fn cubes_scene(width: u32, height: u32) -> Scene {
-    use crate::cubes::*;
-    let aspect = width as f32 / height as f32;
-    let proj = Mat4::perspective(
-        microraster::math::radians(CUBES_FOV_Y_DEG),
-        aspect,
-        CUBES_NEAR,
-        CUBES_FAR,
-    );
-    let view = Mat4::look_at(v3(CUBES_EYE), v3(CUBES_TARGET), v3(CUBES_UP));
-    let positions: Vec<Vec3> = CUBE_VERTICES.iter().map(|&p| v3(p)).collect();
-    let colors: Vec<Rgb888> = (0..CUBE_INDICES.len())
-        .map(|i| {
-            let [r, g, b] = triangle_color(i).unwrap_or([255, 255, 255]);
-            Rgb888::new(r, g, b)
-        })
-        .collect();
-    let bounds = BoundingSphere::from_points(&positions);
-    let objects = CUBE_MODELS
-        .iter()
-        .map(|ops| {
-            let mut model = Mat4::IDENTITY;
-            for op in ops {
-                let m = match *op {
-                    Op::Translate(t) => Mat4::translation(v3(t)),
-                    Op::RotateXDeg(d) => Mat4::rotation_x(microraster::math::radians(d)),
-                    Op::RotateYDeg(d) => Mat4::rotation_y(microraster::math::radians(d)),
-                    Op::RotateZDeg(d) => Mat4::rotation_z(microraster::math::radians(d)),
-                };
-                model = m * model;
-            }
-            Object {
-                positions: positions.clone(),
-                indices: CUBE_INDICES.to_vec(),
-                colors: colors.clone(),
-                bounds,
-                mvp: proj * view * model,
-            }
-        })
-        .collect();
+    let mut objects = Vec::new();
+    crate::cubes::for_each_cube(width, height, |mesh, mvp, _| {
+        let colors = match mesh.colors {
+            MeshColors::PerTriangle(c) => c.to_vec(),
+            _ => vec![Rgb888::WHITE; mesh.indices.len()],
+        };
+        objects.push(Object {
+            positions: mesh.positions.to_vec(),
+            indices: mesh.indices.to_vec(),
+            colors,
+            bounds: mesh.bounds,
+            mvp: *mvp,
+        });
+    });
     Scene {
         objects,
         clip_tris: Vec::new(),

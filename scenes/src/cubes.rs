@@ -1,4 +1,5 @@
-//! The default `cubes` scene, as plain data.
+//! The default `cubes` scene: the four cubes of the 2D-homogeneous
+//! rasterization tutorial.
 //!
 //! Design: the scene is one unit cube mesh (corners at ±1) drawn four times
 //! with different model transforms, seen by a fixed camera. It is kept as
@@ -17,6 +18,10 @@
 //! column vectors `M * [x, y, z, 1]`. Rotations are right-handed: a positive
 //! angle turns counter-clockwise when looking from the positive axis towards
 //! the origin (e.g. `RotateZDeg(90)` maps +x to +y).
+
+use microraster::math::radians;
+use microraster::pixelcolor::Rgb888;
+use microraster::{BoundingSphere, Mat4, Mesh, MeshColors, Vec3};
 
 /// Cube corner positions (model space).
 pub const CUBE_VERTICES: [[f32; 3]; 8] = [
@@ -105,74 +110,27 @@ pub enum Op {
 }
 
 impl Op {
-    /// This step as a row-major 4x4 matrix acting on column vectors
-    /// (`m[row][col]`, translation in the last column).
-    pub fn matrix(self) -> [[f32; 4]; 4] {
-        let rot = |deg: f32| deg.to_radians().sin_cos();
+    /// This step as a matrix (acting on column vectors).
+    pub fn matrix(self) -> Mat4 {
         match self {
-            Op::Translate([x, y, z]) => [
-                [1.0, 0.0, 0.0, x],
-                [0.0, 1.0, 0.0, y],
-                [0.0, 0.0, 1.0, z],
-                [0.0, 0.0, 0.0, 1.0],
-            ],
-            Op::RotateXDeg(a) => {
-                let (s, c) = rot(a);
-                [
-                    [1.0, 0.0, 0.0, 0.0],
-                    [0.0, c, -s, 0.0],
-                    [0.0, s, c, 0.0],
-                    [0.0, 0.0, 0.0, 1.0],
-                ]
-            }
-            Op::RotateYDeg(a) => {
-                let (s, c) = rot(a);
-                [
-                    [c, 0.0, s, 0.0],
-                    [0.0, 1.0, 0.0, 0.0],
-                    [-s, 0.0, c, 0.0],
-                    [0.0, 0.0, 0.0, 1.0],
-                ]
-            }
-            Op::RotateZDeg(a) => {
-                let (s, c) = rot(a);
-                [
-                    [c, -s, 0.0, 0.0],
-                    [s, c, 0.0, 0.0],
-                    [0.0, 0.0, 1.0, 0.0],
-                    [0.0, 0.0, 0.0, 1.0],
-                ]
-            }
+            Op::Translate(t) => Mat4::translation(Vec3::from_array(t)),
+            Op::RotateXDeg(a) => Mat4::rotation_x(radians(a)),
+            Op::RotateYDeg(a) => Mat4::rotation_y(radians(a)),
+            Op::RotateZDeg(a) => Mat4::rotation_z(radians(a)),
         }
     }
 
     /// Applies this step to a point.
     pub fn apply(self, p: [f32; 3]) -> [f32; 3] {
-        let m = self.matrix();
-        [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+        let q = self.matrix().transform_point(Vec3::from_array(p));
+        [q.x, q.y, q.z]
     }
 }
 
 /// The model matrix of `ops` applied in order (first op first), i.e.
-/// `ops[n-1] * ... * ops[1] * ops[0]`, row-major, acting on column vectors.
-pub fn model_matrix(ops: &[Op]) -> [[f32; 4]; 4] {
-    let mut m = [
-        [1.0, 0.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ];
-    for op in ops {
-        let a = op.matrix();
-        let mut out = [[0.0f32; 4]; 4];
-        for (r, row) in out.iter_mut().enumerate() {
-            for (c, cell) in row.iter_mut().enumerate() {
-                *cell = (0..4).map(|k| a[r][k] * m[k][c]).sum();
-            }
-        }
-        m = out;
-    }
-    m
+/// `ops[n-1] * ... * ops[1] * ops[0]`.
+pub fn model_matrix(ops: &[Op]) -> Mat4 {
+    ops.iter().fold(Mat4::IDENTITY, |m, op| op.matrix() * m)
 }
 
 /// Applies `ops` to a point in order (first op first).
@@ -201,9 +159,68 @@ pub const CUBES_NEAR: f32 = 0.1;
 /// Far clipping plane distance.
 pub const CUBES_FAR: f32 = 100.0;
 
+/// Cube corners as core vectors.
+pub const POSITIONS: [Vec3; 8] = {
+    let mut out = [Vec3::ZERO; 8];
+    let mut i = 0;
+    while i < 8 {
+        out[i] = Vec3::from_array(CUBE_VERTICES[i]);
+        i += 1;
+    }
+    out
+};
+
+/// The colour of each of the 12 triangles (its face's colour).
+pub const TRIANGLE_COLORS: [Rgb888; 12] = {
+    let mut out = [Rgb888::new(0, 0, 0); 12];
+    let mut i = 0;
+    while i < 12 {
+        let c = FACE_COLORS[TRIANGLE_FACE[i]];
+        out[i] = Rgb888::new(c[0], c[1], c[2]);
+        i += 1;
+    }
+    out
+};
+
+/// The cube mesh, flat colour per face, with its bounding sphere (centre
+/// 0, radius a little over sqrt(3)).
+pub const MESH: Mesh<'static> = Mesh {
+    positions: &POSITIONS,
+    indices: &CUBE_INDICES,
+    colors: MeshColors::PerTriangle(&TRIANGLE_COLORS),
+    bounds: Some(BoundingSphere {
+        center: Vec3::ZERO,
+        radius: 1.7321,
+    }),
+};
+
+/// Projection times view for a `width x height` frame.
+pub fn view_projection(width: u32, height: u32) -> Mat4 {
+    let aspect = width as f32 / height as f32;
+    let proj = Mat4::perspective(radians(CUBES_FOV_Y_DEG), aspect, CUBES_NEAR, CUBES_FAR);
+    let v = Vec3::from_array;
+    proj * Mat4::look_at(v(CUBES_EYE), v(CUBES_TARGET), v(CUBES_UP))
+}
+
+/// The model-view-projection matrix of each of the four cubes.
+pub fn mvps(width: u32, height: u32) -> [Mat4; 4] {
+    let vp = view_projection(width, height);
+    CUBE_MODELS.map(|ops| vp * model_matrix(&ops))
+}
+
+/// Calls `draw(mesh, mvp, first_id)` for each cube in drawing order; the
+/// triangle ids run 0..48. Works with `Frame::draw_mesh` and
+/// `StripRenderer::draw_mesh` alike.
+pub fn for_each_cube(width: u32, height: u32, mut draw: impl FnMut(&Mesh<'static>, &Mat4, u32)) {
+    for (i, mvp) in mvps(width, height).iter().enumerate() {
+        draw(&MESH, mvp, (i * CUBE_INDICES.len()) as u32);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::vec::Vec;
 
     fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -324,11 +341,10 @@ mod tests {
         // model_matrix agrees with applying the ops in order (M = R * T).
         for ops in &CUBE_MODELS {
             let m = model_matrix(ops);
-            assert_eq!(m[3], [0.0, 0.0, 0.0, 1.0]);
+            assert_eq!(m.row(3), [0.0, 0.0, 0.0, 1.0]);
             for p in CUBE_VERTICES {
-                let q =
-                    [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
-                assert!(close(q, transform_point(ops, p)));
+                let q = m.transform_point(Vec3::from_array(p));
+                assert!(close([q.x, q.y, q.z], transform_point(ops, p)));
             }
         }
     }
