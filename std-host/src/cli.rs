@@ -37,6 +37,10 @@ pub struct Cli {
 pub enum Command {
     /// Render a built-in scene, an OBJ mesh or clip-space triangles to an image.
     Render(RenderArgs),
+    /// Render a scene repeatedly and print timings as JSON (see `bench --help`).
+    Bench(crate::bench::BenchArgs),
+    /// Write reports, e.g. `report speed-vs-error OUT_DIR`.
+    Report(crate::report::ReportArgs),
 }
 
 /// Which triangles face away and are skipped.

@@ -11,12 +11,14 @@
 
 #![forbid(unsafe_code)]
 
+pub mod bench;
 pub mod cli;
 pub mod cliptris;
 pub mod image_out;
 pub mod json;
 pub mod obj;
 pub mod render;
+pub mod report;
 
 /// The default scene's data, from the shared no_std scenes crate.
 pub use microraster_scenes::cubes;

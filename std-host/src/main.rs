@@ -17,6 +17,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => run_render(&args),
+        Command::Bench(args) => microraster_host::bench::run(&args),
+        Command::Report(args) => microraster_host::report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
