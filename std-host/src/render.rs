@@ -30,12 +30,43 @@ pub struct Object {
     pub positions: Vec<Vec3>,
     /// Triangles.
     pub indices: Vec<[u32; 3]>,
-    /// One colour per triangle.
-    pub colors: Vec<Rgb888>,
+    /// Colours: per triangle (flat) or per vertex (Gouraud).
+    pub colors: ObjectColors,
     /// Bounding sphere for whole-object culling.
     pub bounds: Option<BoundingSphere>,
     /// Object to clip space.
     pub mvp: Mat4,
+}
+
+/// The colours of an [`Object`].
+#[derive(Clone, Debug)]
+pub enum ObjectColors {
+    /// One colour per triangle (flat shading).
+    PerTriangle(Vec<Rgb888>),
+    /// One colour per vertex (Gouraud shading, perspective-correct).
+    PerVertex(Vec<Rgb888>),
+}
+
+impl ObjectColors {
+    /// As the core's [`MeshColors`].
+    pub fn as_mesh_colors(&self) -> MeshColors<'_> {
+        match self {
+            ObjectColors::PerTriangle(c) => MeshColors::PerTriangle(c),
+            ObjectColors::PerVertex(c) => MeshColors::PerVertex(c),
+        }
+    }
+}
+
+impl Object {
+    /// As the core's [`Mesh`].
+    pub fn mesh(&self) -> Mesh<'_> {
+        Mesh {
+            positions: &self.positions,
+            indices: &self.indices,
+            colors: self.colors.as_mesh_colors(),
+            bounds: self.bounds,
+        }
+    }
 }
 
 /// Everything to draw in one frame, in drawing order: objects first, then
@@ -66,8 +97,9 @@ pub fn cubes_scene(width: u32, height: u32) -> Scene {
     let mut objects = Vec::new();
     crate::cubes::for_each_cube(width, height, |mesh, mvp, _| {
         let colors = match mesh.colors {
-            MeshColors::PerTriangle(c) => c.to_vec(),
-            _ => vec![Rgb888::WHITE; mesh.indices.len()],
+            MeshColors::PerTriangle(c) => ObjectColors::PerTriangle(c.to_vec()),
+            MeshColors::PerVertex(c) => ObjectColors::PerVertex(c.to_vec()),
+            MeshColors::Uniform(c) => ObjectColors::PerTriangle(vec![c; mesh.indices.len()]),
         };
         objects.push(Object {
             positions: mesh.positions.to_vec(),
@@ -117,7 +149,7 @@ pub fn mesh_scene(
         objects: vec![Object {
             positions,
             indices: indices.to_vec(),
-            colors,
+            colors: ObjectColors::PerTriangle(colors),
             bounds,
             mvp: proj * view,
         }],
@@ -249,13 +281,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
 fn fill<const S: u32>(frame: &mut Frame<'_, S>, scene: &Scene) -> Result<(), Error> {
     let mut id = 0u32;
     for o in &scene.objects {
-        let mesh = Mesh {
-            positions: &o.positions,
-            indices: &o.indices,
-            colors: MeshColors::PerTriangle(&o.colors),
-            bounds: o.bounds,
-        };
-        frame.draw_mesh(&mesh, &o.mvp, id)?;
+        frame.draw_mesh(&o.mesh(), &o.mvp, id)?;
         id = id.wrapping_add(o.indices.len() as u32);
     }
     for t in &scene.clip_tris {
