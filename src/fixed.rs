@@ -106,7 +106,19 @@ pub fn snap<const S: u32>(
     if w.is_nan() || w <= 0.0 {
         return None;
     }
-    let inv_w = 1.0 / w;
+    snap_inv::<S>(x, y, z, 1.0 / w, width, height)
+}
+
+/// [`snap`] with `1 / w` already computed (and `w > 0` already checked).
+#[inline]
+pub(crate) fn snap_inv<const S: u32>(
+    x: f32,
+    y: f32,
+    z: f32,
+    inv_w: f32,
+    width: u32,
+    height: u32,
+) -> Option<SnappedVertex> {
     let half_w = width as f32 * 0.5;
     let half_h = height as f32 * 0.5;
     let scale = (1u32 << S) as f32;

@@ -20,7 +20,7 @@ use crate::depth::{DepthBuffer, DepthFunc};
 use crate::fixed::{guard_band_ndc, MAX_DIMENSION};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::raster::{draw, Strip};
-use crate::setup::{setup, Rejected, SetupTriangle};
+use crate::setup::{setup, setup_geometry, Rejected, SetupTriangle};
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
 /// Which faces to cull.
@@ -111,6 +111,21 @@ pub enum Error {
         /// The slice length.
         actual: usize,
     },
+    /// Bin storage too small (offsets: strips + 1; items:
+    /// [`Frame::bin_entries`]).
+    BinStorageSize {
+        /// Entries needed.
+        expected: usize,
+        /// Entries given.
+        actual: usize,
+    },
+    /// The vertex cache holds fewer entries than the mesh has vertices.
+    VertexCacheSize {
+        /// The mesh's vertex count.
+        expected: usize,
+        /// The cache length.
+        actual: usize,
+    },
     /// The depth slice does not hold exactly the rows asked for.
     DepthBufferSize {
         /// `width * (y1 - y0)`.
@@ -138,6 +153,15 @@ impl core::fmt::Display for Error {
                 write!(
                     f,
                     "colour buffer holds {actual} pixels, expected {expected}"
+                )
+            }
+            Error::BinStorageSize { expected, actual } => {
+                write!(f, "bin storage holds {actual} entries, expected {expected}")
+            }
+            Error::VertexCacheSize { expected, actual } => {
+                write!(
+                    f,
+                    "vertex cache holds {actual} vertices, expected {expected}"
                 )
             }
             Error::DepthBufferSize { expected, actual } => {
@@ -186,6 +210,32 @@ impl Stats {
         self.rejected_index += o.rejected_index;
         self.clipped += o.clipped;
         self.stored += o.stored;
+    }
+}
+
+/// Per-strip triangle bins of a frame, made by [`Frame::bin`].
+#[derive(Debug)]
+pub struct Bins<'b> {
+    strip_rows: u32,
+    offsets: &'b [u32],
+    items: &'b [u32],
+}
+
+impl Bins<'_> {
+    /// Rows per strip.
+    pub fn strip_rows(&self) -> u32 {
+        self.strip_rows
+    }
+
+    /// The number of strips.
+    pub fn strips(&self) -> u32 {
+        self.offsets.len().saturating_sub(1) as u32
+    }
+
+    /// The rows `y0..y1` of strip `strip` in a frame of `height` rows.
+    pub fn rows(&self, strip: u32, height: u32) -> (u32, u32) {
+        let y0 = strip.saturating_mul(self.strip_rows);
+        (y0, y0.saturating_add(self.strip_rows).min(height))
     }
 }
 
@@ -299,6 +349,59 @@ impl Mesh<'_> {
             };
         }
         Some(verts)
+    }
+}
+
+/// Outcode bit for a vertex with a NaN or infinite coordinate.
+const NONFINITE: u16 = 1 << 15;
+
+/// A vertex after the vertex stage (see [`Frame::draw_mesh_cached`]):
+/// clip-space position, outcode and, where no clipping can touch it, its
+/// snapped window position.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProcessedVertex {
+    pos: Vec4,
+    inv_w: f32,
+    snap: crate::fixed::SnappedVertex,
+    code: u16,
+    snapped: bool,
+}
+
+impl ProcessedVertex {
+    /// A placeholder to fill a cache with.
+    pub const EMPTY: ProcessedVertex = ProcessedVertex {
+        pos: Vec4::new(0.0, 0.0, 0.0, 0.0),
+        inv_w: 0.0,
+        snap: crate::fixed::SnappedVertex { x: 0, y: 0, z: 0 },
+        code: 0,
+        snapped: false,
+    };
+
+    #[inline]
+    fn new<const S: u32>(pos: Vec4, gx: f32, gy: f32, width: u32, height: u32) -> Self {
+        if !pos.is_finite() {
+            return ProcessedVertex {
+                pos,
+                code: NONFINITE,
+                ..ProcessedVertex::EMPTY
+            };
+        }
+        let code = outcode(pos, gx, gy);
+        let mut v = ProcessedVertex {
+            pos,
+            code,
+            ..ProcessedVertex::EMPTY
+        };
+        if code & outcode::CLIP == 0 && pos.w > 0.0 {
+            v.inv_w = 1.0 / pos.w;
+            if let Some(s) =
+                crate::fixed::snap_inv::<S>(pos.x, pos.y, pos.z, v.inv_w, width, height)
+            {
+                v.snap = s;
+                v.snapped = true;
+            }
+        }
+        v
     }
 }
 
@@ -440,6 +543,145 @@ impl<'s, const S: u32> Frame<'s, S> {
         Ok(())
     }
 
+    /// Like [`Frame::draw_mesh`], with every vertex transformed, outcoded
+    /// and snapped once instead of once per triangle that uses it: the fast
+    /// path for indexed meshes. `cache` is scratch space of at least
+    /// `mesh.positions.len()` entries. The result is identical to
+    /// [`Frame::draw_mesh`]'s.
+    pub fn draw_mesh_cached(
+        &mut self,
+        mesh: &Mesh<'_>,
+        mvp: &Mat4,
+        first_id: u32,
+        cache: &mut [ProcessedVertex],
+    ) -> Result<(), Error> {
+        let count = mesh.indices.len() as u32;
+        let cache = match cache.get_mut(..mesh.positions.len()) {
+            Some(c) => c,
+            None => {
+                return Err(Error::VertexCacheSize {
+                    expected: mesh.positions.len(),
+                    actual: cache.len(),
+                })
+            }
+        };
+        if let Some(b) = mesh.bounds {
+            if b.outside_frustum(mvp) {
+                self.stats.submitted += count;
+                self.stats.culled_object += count;
+                return Ok(());
+            }
+        }
+        let c = self.config;
+        let (gx, gy) = self.guard;
+        for (p, v) in mesh.positions.iter().zip(cache.iter_mut()) {
+            *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
+        }
+        let start_len = self.len;
+        let start_stats = self.stats;
+        let mut stats = Stats::default();
+        for (i, idx) in mesh.indices.iter().enumerate() {
+            let id = first_id.wrapping_add(i as u32);
+            stats.submitted += 1;
+            let (Some(a), Some(b), Some(d)) = (
+                cache.get(idx[0] as usize),
+                cache.get(idx[1] as usize),
+                cache.get(idx[2] as usize),
+            ) else {
+                stats.rejected_index += 1;
+                continue;
+            };
+            let v = [a, b, d];
+            let color = |k: usize| -> Option<[f32; 3]> {
+                Some(rgb_f32(match mesh.colors {
+                    MeshColors::Uniform(c) => c,
+                    MeshColors::PerTriangle(cs) => *cs.get(i)?,
+                    MeshColors::PerVertex(cs) => *cs.get(idx[k] as usize)?,
+                }))
+            };
+            let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
+            if or & NONFINITE != 0 {
+                stats.rejected_nonfinite += 1;
+                continue;
+            }
+            if and & outcode::FRUSTUM != 0 {
+                stats.culled_frustum += 1;
+                continue;
+            }
+            if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
+                // Fast path: vertices already snapped; the triangle goes
+                // straight into its storage slot.
+                let g = match setup_geometry::<S>(
+                    &[a.snap, b.snap, d.snap],
+                    c.width,
+                    c.height,
+                    c.cull,
+                    c.front_face,
+                ) {
+                    Ok(g) => g,
+                    Err(r) => {
+                        count_rejected(&mut stats, r);
+                        continue;
+                    }
+                };
+                let (Some(c0), Some(c1), Some(c2)) = (color(0), color(1), color(2)) else {
+                    stats.rejected_index += 1;
+                    continue;
+                };
+                let Some(slot) = self.storage.get_mut(self.len) else {
+                    self.len = start_len;
+                    self.stats = start_stats;
+                    return Err(Error::StorageFull {
+                        capacity: self.storage.len(),
+                        needed: mesh.indices.len() - i,
+                    });
+                };
+                *slot = g.finish([a.inv_w, b.inv_w, d.inv_w], [c0, c1, c2], id);
+                self.len += 1;
+                stats.stored += 1;
+                continue;
+            }
+            let (Some(c0), Some(c1), Some(c2)) = (color(0), color(1), color(2)) else {
+                stats.rejected_index += 1;
+                continue;
+            };
+            let tri = [
+                ClipVertex {
+                    pos: v[0].pos,
+                    color: c0,
+                },
+                ClipVertex {
+                    pos: v[1].pos,
+                    color: c1,
+                },
+                ClipVertex {
+                    pos: v[2].pos,
+                    color: c2,
+                },
+            ];
+            let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
+            process::<S>(&c, self.guard, &tri, id, &mut stats, &mut out);
+            for t in out {
+                match self.storage.get_mut(self.len) {
+                    Some(slot) => {
+                        *slot = t;
+                        self.len += 1;
+                    }
+                    None => {
+                        self.len = start_len;
+                        self.stats = start_stats;
+                        return Err(Error::StorageFull {
+                            capacity: self.storage.len(),
+                            needed: mesh.indices.len() - i,
+                        });
+                    }
+                }
+            }
+        }
+        self.stats.add(&stats);
+        Ok(())
+    }
+
     /// Submits every triangle of `mesh`, transformed by `mvp` (object to
     /// clip space). Triangle `i` gets the id `first_id + i`. The bounding
     /// sphere, if given, is tested first: an object entirely outside the
@@ -476,6 +718,121 @@ impl<'s, const S: u32> Frame<'s, S> {
             }
         }
         Ok(())
+    }
+
+    /// The number of bin entries [`Frame::bin`] needs for strips of
+    /// `strip_rows` rows: one per (triangle, strip it touches).
+    pub fn bin_entries(&self, strip_rows: u32) -> usize {
+        let r = strip_rows.max(1);
+        self.triangles()
+            .iter()
+            .map(|t| (t.max_y as u32 / r - t.min_y as u32 / r) as usize + 1)
+            .sum()
+    }
+
+    /// Sorts the stored triangles into per-strip bins (strips of
+    /// `strip_rows` rows from row 0), in caller-provided storage: `offsets`
+    /// needs one entry per strip plus one, `items` [`Frame::bin_entries`]
+    /// entries. Each bin keeps submission order, so
+    /// [`Frame::render_strip`] gives the same pixels as
+    /// [`Frame::render_rows`] while touching only the triangles that reach
+    /// the strip.
+    pub fn bin<'b>(
+        &self,
+        strip_rows: u32,
+        offsets: &'b mut [u32],
+        items: &'b mut [u32],
+    ) -> Result<Bins<'b>, Error> {
+        let r = strip_rows.max(1);
+        let strips = self.config.height.div_ceil(r) as usize;
+        let need_items = self.bin_entries(r);
+        if offsets.len() < strips + 1 {
+            return Err(Error::BinStorageSize {
+                expected: strips + 1,
+                actual: offsets.len(),
+            });
+        }
+        if items.len() < need_items || need_items > u32::MAX as usize {
+            return Err(Error::BinStorageSize {
+                expected: need_items,
+                actual: items.len(),
+            });
+        }
+        let offsets = &mut offsets[..strips + 1];
+        offsets.fill(0);
+        // Count into offsets[s + 1], prefix-sum into starts, fill using
+        // offsets[s] as the cursor (it ends at the start of s + 1), then
+        // shift back: no scratch beyond the two slices.
+        for t in self.triangles() {
+            for s in t.min_y as u32 / r..=t.max_y as u32 / r {
+                if let Some(o) = offsets.get_mut(s as usize + 1) {
+                    *o += 1;
+                }
+            }
+        }
+        for s in 1..offsets.len() {
+            offsets[s] += offsets[s - 1];
+        }
+        for (i, t) in self.triangles().iter().enumerate() {
+            for s in t.min_y as u32 / r..=t.max_y as u32 / r {
+                if let Some(o) = offsets.get_mut(s as usize) {
+                    if let Some(slot) = items.get_mut(*o as usize) {
+                        *slot = i as u32;
+                    }
+                    *o += 1;
+                }
+            }
+        }
+        for s in (1..offsets.len()).rev() {
+            offsets[s] = offsets[s - 1];
+        }
+        offsets[0] = 0;
+        Ok(Bins {
+            strip_rows: r,
+            offsets,
+            items: &items[..need_items],
+        })
+    }
+
+    /// Renders strip `strip` (rows `strip * strip_rows ..`, the last strip
+    /// possibly shorter) of a binned frame into buffers that hold exactly
+    /// those rows. The same pixels as [`Frame::render_rows`] for those rows.
+    pub fn render_strip<C: Pixel, D: DepthBuffer + ?Sized>(
+        &self,
+        bins: &Bins<'_>,
+        strip: u32,
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<RenderStats, Error> {
+        let (y0, y1) = bins.rows(strip, self.config.height);
+        check_rows(&self.config, y0, y1, color.len(), depth.depth_len())?;
+        let (Some(&a), Some(&b)) = (
+            bins.offsets.get(strip as usize),
+            bins.offsets.get(strip as usize + 1),
+        ) else {
+            return Err(Error::InvalidRows {
+                y0,
+                y1,
+                height: self.config.height,
+            });
+        };
+        let mut strip = Strip {
+            width: self.config.width as usize,
+            y0,
+            y1,
+            color,
+            depth,
+            depth_func: self.config.depth_func,
+            depth_write: self.config.depth_write,
+        };
+        let mut stats = RenderStats::default();
+        let tris = self.triangles();
+        for &i in bins.items.get(a as usize..b as usize).unwrap_or(&[]) {
+            if let Some(t) = tris.get(i as usize) {
+                stats.pixels_written += draw::<S, C, D>(t, &mut strip) as u64;
+            }
+        }
+        Ok(stats)
     }
 
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which
@@ -618,5 +975,131 @@ pub(crate) fn check_size(config: &Config) -> Result<(), Error> {
             width: config.width,
             height: config.height,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::TriangleId;
+    use crate::depth::NoDepth;
+
+    /// A deterministic pseudo-random scene of overlapping triangles.
+    fn scene(frame: &mut Frame<'_>, n: u32) {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32 * 2.4 - 1.2
+        };
+        for i in 0..n {
+            let p = [0, 1, 2].map(|_| Vec4::new(rnd(), rnd(), rnd() * 0.9, 1.0));
+            let c = Rgb888::new((i * 37) as u8, (i * 91) as u8, (i * 13) as u8);
+            frame.push_clip_triangle(p, [c; 3], i).unwrap();
+        }
+    }
+
+    #[test]
+    fn binned_strips_equal_unbinned_rows() {
+        let mut storage = [SetupTriangle::EMPTY; 200];
+        let mut config = Config::new(40, 37);
+        config.cull = CullMode::None;
+        let mut frame: Frame = Frame::new(config, &mut storage).unwrap();
+        scene(&mut frame, 60);
+        let mut whole = [TriangleId(0); 40 * 37];
+        let mut zw = [u32::MAX; 40 * 37];
+        frame.render_rows(0, 37, &mut whole, &mut zw[..]).unwrap();
+        for r in [1u32, 5, 16, 37, 100] {
+            let mut offsets = [0u32; 40];
+            let mut items = [0u32; 2000];
+            assert!(frame.bin_entries(r) <= items.len());
+            let bins = frame.bin(r, &mut offsets, &mut items).unwrap();
+            let mut out = [TriangleId(0); 40 * 37];
+            let mut zo = [u32::MAX; 40 * 37];
+            for s in 0..bins.strips() {
+                let (y0, y1) = bins.rows(s, 37);
+                let range = y0 as usize * 40..y1 as usize * 40;
+                frame
+                    .render_strip(&bins, s, &mut out[range.clone()], &mut zo[range])
+                    .unwrap();
+            }
+            assert_eq!(out, whole, "strip rows {r}");
+            assert_eq!(zo, zw, "strip rows {r}");
+        }
+    }
+
+    #[test]
+    fn bin_storage_too_small_is_an_error() {
+        let mut storage = [SetupTriangle::EMPTY; 200];
+        let mut config = Config::new(40, 37);
+        config.cull = CullMode::None;
+        let mut frame: Frame = Frame::new(config, &mut storage).unwrap();
+        scene(&mut frame, 20);
+        let mut offsets = [0u32; 4];
+        let mut items = [0u32; 2000];
+        assert!(matches!(
+            frame.bin(16, &mut offsets[..3], &mut items),
+            Err(Error::BinStorageSize { expected: 4, .. })
+        ));
+        let need = frame.bin_entries(16);
+        assert!(matches!(
+            frame.bin(16, &mut offsets, &mut items[..need - 1]),
+            Err(Error::BinStorageSize { .. })
+        ));
+        let bins = frame.bin(16, &mut offsets, &mut items).unwrap();
+        let mut c = [TriangleId(0); 40 * 16];
+        assert!(frame.render_strip(&bins, 3, &mut c, &mut NoDepth).is_err());
+    }
+
+    #[test]
+    fn cached_mesh_equals_uncached() {
+        let positions: [Vec3; 6] = [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.5),
+            Vec3::new(0.0, 1.0, -0.5),
+            Vec3::new(3.0, 0.0, -3.0),
+            Vec3::new(-2.0, 2.0, 2.5),
+            Vec3::new(0.5, 0.5, f32::NAN),
+        ];
+        let indices = [
+            [0, 1, 2],
+            [1, 3, 2],
+            [2, 4, 0],
+            [0, 4, 3],
+            [1, 5, 2],
+            [0, 9, 1],
+        ];
+        let colors = [Rgb888::new(200, 10, 10); 6];
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: MeshColors::PerVertex(&colors),
+            bounds: None,
+        };
+        for angle in [0.0f32, 0.7, 1.9, 3.0] {
+            let mvp = Mat4::perspective(1.2, 1.0, 0.5, 20.0)
+                * Mat4::translation(Vec3::new(0.0, 0.0, -2.2))
+                * Mat4::rotation_y(angle);
+            let mut config = Config::new(32, 32);
+            config.cull = CullMode::None;
+            let mut s1 = [SetupTriangle::EMPTY; 64];
+            let mut a: Frame = Frame::new(config, &mut s1).unwrap();
+            a.draw_mesh(&mesh, &mvp, 7).unwrap();
+            let mut s2 = [SetupTriangle::EMPTY; 64];
+            let mut b: Frame = Frame::new(config, &mut s2).unwrap();
+            let mut cache = [ProcessedVertex::EMPTY; 6];
+            b.draw_mesh_cached(&mesh, &mvp, 7, &mut cache).unwrap();
+            assert_eq!(a.triangles(), b.triangles(), "angle {angle}");
+            assert_eq!(a.stats(), b.stats(), "angle {angle}");
+            let mut small = [ProcessedVertex::EMPTY; 5];
+            assert!(matches!(
+                b.draw_mesh_cached(&mesh, &mvp, 7, &mut small),
+                Err(Error::VertexCacheSize {
+                    expected: 6,
+                    actual: 5
+                })
+            ));
+        }
     }
 }

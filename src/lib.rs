@@ -47,6 +47,7 @@
 pub mod clip;
 mod color;
 mod depth;
+mod draw_target;
 pub mod fixed;
 mod frame;
 mod immediate;
@@ -57,9 +58,11 @@ mod setup;
 pub use clip::ClipVertex;
 pub use color::{Pixel, TriangleId};
 pub use depth::{DepthBuffer, DepthFunc, NoDepth};
+pub use draw_target::{DrawError, StripDepth, StripDrawer};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
 pub use frame::{
-    BoundingSphere, Config, CullMode, Error, Frame, FrontFace, Mesh, MeshColors, RenderStats, Stats,
+    Bins, BoundingSphere, Config, CullMode, Error, Frame, FrontFace, Mesh, MeshColors,
+    ProcessedVertex, RenderStats, Stats,
 };
 pub use immediate::StripRenderer;
 pub use math::{Mat4, Vec3, Vec4};

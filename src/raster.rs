@@ -16,17 +16,26 @@
 //! loop then visits only covered pixels; it never divides and never tests
 //! coverage.
 //!
-//! Depth is the plane through the three `Z32` vertex depths. At the start of
-//! each span it is evaluated exactly (`i128`, floor) in `Z32.16`; along the
-//! span it steps by the rounded gradient in wrapping `i64`. With at most
-//! `2^14` steps the accumulated error is below `2^13` units of `2^-16`, so
-//! the written `Z32` is within 1 LSB of the exact plane's floor. Where the
-//! gradient is huge (slivers) wrapping arithmetic keeps covered pixels exact
-//! modulo `2^64`, and their true values are in range.
+//! Small triangles (box at most [`SMALL_WIDTH`] pixels wide) skip the
+//! divisions and test the sign of the three edge values at every pixel of
+//! their box instead; both paths cover exactly the same pixels.
 //!
-//! Colour, when it varies, is perspective-correct: the barycentric weights
-//! are the exact edge values converted to `f32` at each pixel, so the result
-//! at a pixel does not depend on where traversal started.
+//! Depth is the plane through the three `Z32` vertex depths, evaluated from
+//! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
+//! in `f64` at the start of each run of pixels (a box row for small
+//! triangles, every [`RESYNC`] pixels of a span) and stepped by its `f64`
+//! gradient in between. At a covered pixel each term is at most `2^32`, so
+//! the error is far below one `Z32` LSB (under `2^-10` with the steps) and
+//! the written `Z32` is the floor of the exact plane value, or one off only
+//! where that value lies that close to an integer. Runs start where the
+//! triangle's geometry says (its box, its exact spans), never where a strip
+//! starts, so the result does not depend on the strip split (IEEE `f64` is
+//! deterministic, in software on FPU-less cores too).
+//!
+//! Colour, when it varies, is perspective-correct: `sum(E_k c_k / w_k) /
+//! sum(E_k / w_k)` with the exact edge values converted to `f32` at the
+//! start of each run and the four sums stepped in `f32` along it; one
+//! division per pixel.
 
 use crate::color::Pixel;
 use crate::depth::{DepthBuffer, DepthFunc};
@@ -105,6 +114,147 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
     pub depth_write: bool,
 }
 
+/// Triangles whose bounding box is at most this many pixels wide are
+/// traversed pixel by pixel over the box (cheaper than three divisions per
+/// row); wider ones by exact spans.
+const SMALL_WIDTH: u16 = 24;
+
+/// Re-evaluate interpolants from the exact edge values every this many
+/// pixels along a span, so float stepping error stays bounded.
+const RESYNC: i64 = 16;
+
+/// Per-triangle constants for shading a covered pixel.
+struct Shader {
+    /// `Z0` as `f64`.
+    z0: f64,
+    /// `(Z1 - Z0) / area` and `(Z2 - Z0) / area`.
+    k1: f64,
+    k2: f64,
+    /// Depth change per pixel.
+    dz: f64,
+    /// Unbiased edge value = biased value - bias.
+    bias: [i64; 3],
+    /// Colour numerators (r, g, b) and denominator change per pixel.
+    dc: [f32; 4],
+    smooth: bool,
+}
+
+/// Interpolants at one pixel: depth and colour numerators/denominator.
+#[derive(Clone, Copy)]
+struct Acc {
+    z: f64,
+    c: [f32; 4],
+}
+
+impl Shader {
+    fn new<C: Pixel, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Shader {
+        let (mut k1, mut k2, mut dz) = (0.0, 0.0, 0.0);
+        if D::ENABLED {
+            let inv_area = 1.0 / t.area as f64;
+            k1 = (t.z[1] as f64 - t.z[0] as f64) * inv_area;
+            k2 = (t.z[2] as f64 - t.z[0] as f64) * inv_area;
+            dz = k1 * edges[1].step_x as f64 + k2 * edges[2].step_x as f64;
+        }
+        let smooth = C::SHADED && t.smooth;
+        let mut dc = [0.0f32; 4];
+        if smooth {
+            let st = [
+                edges[0].step_x as f32,
+                edges[1].step_x as f32,
+                edges[2].step_x as f32,
+            ];
+            let cw = &t.color_w;
+            for (c, d) in dc.iter_mut().enumerate().take(3) {
+                *d = st[0] * cw[0][c] + st[1] * cw[1][c] + st[2] * cw[2][c];
+            }
+            dc[3] = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
+        }
+        Shader {
+            z0: t.z[0] as f64,
+            k1,
+            k2,
+            dz,
+            bias: [edges[0].bias, edges[1].bias, edges[2].bias],
+            dc,
+            smooth,
+        }
+    }
+
+    /// The interpolants at the pixel whose biased edge values are `e`,
+    /// evaluated from the exact edge values.
+    #[inline(always)]
+    fn start<D: DepthBuffer + ?Sized>(&self, t: &SetupTriangle, e: [i64; 3]) -> Acc {
+        let e = [
+            e[0] - self.bias[0],
+            e[1] - self.bias[1],
+            e[2] - self.bias[2],
+        ];
+        let z = if D::ENABLED {
+            self.z0 + self.k1 * e[1] as f64 + self.k2 * e[2] as f64
+        } else {
+            0.0
+        };
+        let mut c = [0.0f32; 4];
+        if self.smooth {
+            let f = [e[0] as f32, e[1] as f32, e[2] as f32];
+            let cw = &t.color_w;
+            for (ch, v) in c.iter_mut().enumerate().take(3) {
+                *v = f[0] * cw[0][ch] + f[1] * cw[1][ch] + f[2] * cw[2][ch];
+            }
+            c[3] = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
+        }
+        Acc { z, c }
+    }
+
+    /// Moves the interpolants one pixel to the right.
+    #[inline(always)]
+    fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc) {
+        if D::ENABLED {
+            a.z += self.dz;
+        }
+        if self.smooth {
+            for k in 0..4 {
+                a.c[k] += self.dc[k];
+            }
+        }
+    }
+
+    /// Depth-tests and writes the pixel at `idx` with interpolants `a`.
+    /// Returns 1 if written.
+    #[inline(always)]
+    fn pixel<C: Pixel, D: DepthBuffer + ?Sized>(
+        &self,
+        t: &SetupTriangle,
+        strip: &mut Strip<'_, C, D>,
+        idx: usize,
+        a: &Acc,
+    ) -> u32 {
+        if D::ENABLED {
+            let z32 = a.z as u32; // saturating, floors
+            if !strip
+                .depth
+                .test_and_set(idx, z32, strip.depth_func, strip.depth_write)
+            {
+                return 0;
+            }
+        }
+        let rgb = if self.smooth {
+            let inv = 1.0 / a.c[3];
+            let ch = |c: usize| (a.c[c] * inv + 0.5) as u8;
+            Rgb888::new(ch(0), ch(1), ch(2))
+        } else {
+            t.flat
+        };
+        match strip.color.get_mut(idx) {
+            Some(px) => {
+                *px = C::from_fragment(rgb, t.id);
+                1
+            }
+            None => 0,
+        }
+    }
+}
+
 /// Draws one triangle into the strip; returns the number of pixels written.
 pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
     t: &SetupTriangle,
@@ -125,92 +275,62 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
         Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
         Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
     ];
+    let shader = Shader::new::<C, D>(t, &edges);
     let max_n = (t.max_x - t.min_x) as i64;
-
-    // Depth plane in Z32.16, relative to vertex 0:
-    // Z = Z0 + ((Z1 - Z0) E1 + (Z2 - Z0) E2) / area.
-    let dz1 = t.z[1] as i128 - t.z[0] as i128;
-    let dz2 = t.z[2] as i128 - t.z[0] as i128;
-    let area = t.area as i128;
-    let z_step: i64 = if D::ENABLED {
-        let num = (dz1 * edges[1].step_x as i128 + dz2 * edges[2].step_x as i128) << 16;
-        // Round to nearest; `as i64` wraps (see the design note).
-        let q = if num >= 0 {
-            (num + area / 2) / area
-        } else {
-            -((-num + area / 2) / area)
-        };
-        q as i64
-    } else {
-        0
-    };
-
-    let smooth = C::SHADED && t.smooth;
     let mut written = 0u32;
-    for row in row_first..=row_last {
+    let mut base = (row_first - strip.y0) as usize * strip.width + t.min_x as usize;
+
+    if t.max_x - t.min_x < SMALL_WIDTH {
+        // Pixel by pixel over the box: a sign test per pixel.
+        let step = [edges[0].step_x, edges[1].step_x, edges[2].step_x];
+        for _ in row_first..=row_last {
+            let mut e = [edges[0].row, edges[1].row, edges[2].row];
+            let mut acc = shader.start::<D>(t, e);
+            for n in 0..=max_n as usize {
+                if (e[0] | e[1] | e[2]) >= 0 {
+                    written += shader.pixel(t, strip, base + n, &acc);
+                }
+                e[0] += step[0];
+                e[1] += step[1];
+                e[2] += step[2];
+                shader.step::<D>(&mut acc);
+            }
+            for edge in edges.iter_mut() {
+                edge.row += edge.step_y;
+            }
+            base += strip.width;
+        }
+        return written;
+    }
+
+    for _ in row_first..=row_last {
         let mut lo = 0i64;
         let mut hi = max_n;
         let covered = edges[0].clip_span(&mut lo, &mut hi)
             && edges[1].clip_span(&mut lo, &mut hi)
             && edges[2].clip_span(&mut lo, &mut hi);
         if covered {
-            // Unbiased edge values at the span start.
             let mut e = [
-                edges[0].row - edges[0].bias + edges[0].step_x * lo,
-                edges[1].row - edges[1].bias + edges[1].step_x * lo,
-                edges[2].row - edges[2].bias + edges[2].step_x * lo,
+                edges[0].row + edges[0].step_x * lo,
+                edges[1].row + edges[1].step_x * lo,
+                edges[2].row + edges[2].step_x * lo,
             ];
-            let mut z: i64 = if D::ENABLED {
-                let num = (dz1 * e[1] as i128 + dz2 * e[2] as i128) << 16;
-                (((t.z[0] as i128) << 16) + num.div_euclid(area)) as i64
-            } else {
-                0
-            };
-            let base = (row - strip.y0) as usize * strip.width + t.min_x as usize;
+            let mut acc = shader.start::<D>(t, e);
             for n in lo..=hi {
-                let idx = base + n as usize;
-                let pass = if D::ENABLED {
-                    let z32 = (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32;
-                    strip
-                        .depth
-                        .test_and_set(idx, z32, strip.depth_func, strip.depth_write)
-                } else {
-                    true
-                };
-                if pass {
-                    let rgb = if smooth { shade(t, &e) } else { t.flat };
-                    if let Some(px) = strip.color.get_mut(idx) {
-                        *px = C::from_fragment(rgb, t.id);
-                        written += 1;
-                    }
+                if (n - lo) % RESYNC == 0 && n != lo {
+                    acc = shader.start::<D>(t, e);
                 }
-                if D::ENABLED {
-                    z = z.wrapping_add(z_step);
-                }
-                if smooth {
-                    e[0] += edges[0].step_x;
-                    e[1] += edges[1].step_x;
-                    e[2] += edges[2].step_x;
-                }
+                written += shader.pixel(t, strip, base + n as usize, &acc);
+                e[0] += edges[0].step_x;
+                e[1] += edges[1].step_x;
+                e[2] += edges[2].step_x;
+                shader.step::<D>(&mut acc);
             }
         }
         for edge in edges.iter_mut() {
             edge.row += edge.step_y;
         }
+        base += strip.width;
     }
     written
-}
-
-/// Perspective-correct colour from the exact edge values at a pixel.
-#[inline]
-fn shade(t: &SetupTriangle, e: &[i64; 3]) -> Rgb888 {
-    let f = [e[0] as f32, e[1] as f32, e[2] as f32];
-    let den = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
-    let inv = 1.0 / den;
-    let cw = &t.color_w;
-    let ch = |c: usize| {
-        let v = (f[0] * cw[0][c] + f[1] * cw[1][c] + f[2] * cw[2][c]) * inv;
-        (v + 0.5) as u8
-    };
-    Rgb888::new(ch(0), ch(1), ch(2))
 }

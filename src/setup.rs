@@ -20,7 +20,7 @@
 //! record small for RAM-starved targets.
 
 use crate::clip::ClipVertex;
-use crate::fixed::snap;
+use crate::fixed::{snap, SnappedVertex};
 use crate::frame::{CullMode, FrontFace};
 use embedded_graphics_core::pixelcolor::Rgb888;
 
@@ -43,7 +43,7 @@ pub struct SetupTriangle {
     pub(crate) max_x: u16,
     pub(crate) min_y: u16,
     pub(crate) max_y: u16,
-    /// For perspective-correct colour: `w_min / w_k` (in `(0, 1]`).
+    /// For perspective-correct colour: `1 / w_k`, rescaled if extreme.
     pub(crate) inv_w: [f32; 3],
     /// Colour times `inv_w`, per vertex.
     pub(crate) color_w: [[f32; 3]; 3],
@@ -135,16 +135,42 @@ pub(crate) fn setup<const S: u32>(
     front: FrontFace,
     id: u32,
 ) -> Result<SetupTriangle, Rejected> {
-    let mut sx = [0i32; 3];
-    let mut sy = [0i32; 3];
-    let mut sz = [0u32; 3];
+    let mut s = [SnappedVertex::default(); 3];
     for k in 0..3 {
         let p = v[k].pos;
-        let s = snap::<S>(p.x, p.y, p.z, p.w, width, height).ok_or(Rejected::NonFinite)?;
-        sx[k] = s.x;
-        sy[k] = s.y;
-        sz[k] = s.z;
+        s[k] = snap::<S>(p.x, p.y, p.z, p.w, width, height).ok_or(Rejected::NonFinite)?;
     }
+    let g = setup_geometry::<S>(&s, width, height, cull, front)?;
+    Ok(g.finish(
+        [1.0 / v[0].pos.w, 1.0 / v[1].pos.w, 1.0 / v[2].pos.w],
+        [v[0].color, v[1].color, v[2].color],
+        id,
+    ))
+}
+
+/// The part of setup that needs only the snapped vertices: area, culling,
+/// winding and bounding box. Cheap, so culled triangles cost little.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Geometry {
+    x: [i32; 3],
+    y: [i32; 3],
+    z: [u32; 3],
+    area: i64,
+    swapped: bool,
+    bbox: [u16; 4],
+}
+
+/// Area, culling, winding and bounding box of a snapped triangle.
+#[inline]
+pub(crate) fn setup_geometry<const S: u32>(
+    s: &[SnappedVertex; 3],
+    width: u32,
+    height: u32,
+    cull: CullMode,
+    front: FrontFace,
+) -> Result<Geometry, Rejected> {
+    let sx = [s[0].x, s[1].x, s[2].x];
+    let sy = [s[0].y, s[1].y, s[2].y];
     let area = area2(sx, sy);
     if area == 0 {
         return Err(Rejected::Degenerate);
@@ -161,23 +187,25 @@ pub(crate) fn setup<const S: u32>(
         CullMode::Front if is_front => return Err(Rejected::Backface),
         _ => {}
     }
-    let mut order = [0usize, 1, 2];
-    let mut area = area;
-    if area < 0 {
-        order = [0, 2, 1];
-        area = -area;
-    }
-    let x = [sx[order[0]], sx[order[1]], sx[order[2]]];
-    let y = [sy[order[0]], sy[order[1]], sy[order[2]]];
-    let z = [sz[order[0]], sz[order[1]], sz[order[2]]];
+    let swapped = area < 0;
+    let (x, y, z, area) = if swapped {
+        (
+            [sx[0], sx[2], sx[1]],
+            [sy[0], sy[2], sy[1]],
+            [s[0].z, s[2].z, s[1].z],
+            -area,
+        )
+    } else {
+        (sx, sy, [s[0].z, s[1].z, s[2].z], area)
+    };
 
     // Pixels whose centre (i << S) + half lies in [min, max].
     let half = 1i64 << (S - 1);
     let one = 1i64 << S;
-    let min_x = *x.iter().min().unwrap_or(&0) as i64;
-    let max_x = *x.iter().max().unwrap_or(&0) as i64;
-    let min_y = *y.iter().min().unwrap_or(&0) as i64;
-    let max_y = *y.iter().max().unwrap_or(&0) as i64;
+    let min_x = x[0].min(x[1]).min(x[2]) as i64;
+    let max_x = x[0].max(x[1]).max(x[2]) as i64;
+    let min_y = y[0].min(y[1]).min(y[2]) as i64;
+    let max_y = y[0].max(y[1]).max(y[2]) as i64;
     let px0 = (min_x - half + one - 1) >> S;
     let px1 = (max_x - half) >> S;
     let py0 = (min_y - half + one - 1) >> S;
@@ -190,38 +218,72 @@ pub(crate) fn setup<const S: u32>(
         return Err(Rejected::Offscreen);
     }
     let clamp = |v: i64, hi: i64| v.clamp(0, hi) as u16;
-
-    // Colour: flat when all three vertex colours are equal.
-    let c = [v[order[0]].color, v[order[1]].color, v[order[2]].color];
-    let smooth = c[0] != c[1] || c[0] != c[2];
-    let to_u8 = |f: f32| (f + 0.5) as u8;
-    let flat = Rgb888::new(to_u8(c[0][0]), to_u8(c[0][1]), to_u8(c[0][2]));
-    let mut inv_w = [1.0f32; 3];
-    let mut color_w = [[0.0f32; 3]; 3];
-    if smooth {
-        let ws = [v[order[0]].pos.w, v[order[1]].pos.w, v[order[2]].pos.w];
-        let w_min = ws[0].min(ws[1]).min(ws[2]);
-        for k in 0..3 {
-            inv_w[k] = w_min / ws[k];
-            for ch in 0..3 {
-                color_w[k][ch] = c[k][ch] * inv_w[k];
-            }
-        }
-    }
-
-    Ok(SetupTriangle {
+    Ok(Geometry {
         x,
         y,
         z,
         area,
-        min_x: clamp(px0, w - 1),
-        max_x: clamp(px1, w - 1),
-        min_y: clamp(py0, h - 1),
-        max_y: clamp(py1, h - 1),
-        inv_w,
-        color_w,
-        flat,
-        smooth,
-        id,
+        swapped,
+        bbox: [
+            clamp(px0, w - 1),
+            clamp(px1, w - 1),
+            clamp(py0, h - 1),
+            clamp(py1, h - 1),
+        ],
     })
+}
+
+impl Geometry {
+    /// Completes setup with the vertices' `1 / w` (all positive) and
+    /// colours, in input order (the winding swap is applied here).
+    #[inline]
+    pub(crate) fn finish(self, inv_w: [f32; 3], color: [[f32; 3]; 3], id: u32) -> SetupTriangle {
+        let (iw, c) = if self.swapped {
+            (
+                [inv_w[0], inv_w[2], inv_w[1]],
+                [color[0], color[2], color[1]],
+            )
+        } else {
+            (inv_w, color)
+        };
+        // Colour: flat when all three vertex colours are equal.
+        let smooth = c[0] != c[1] || c[0] != c[2];
+        let to_u8 = |f: f32| (f + 0.5) as u8;
+        let flat = Rgb888::new(to_u8(c[0][0]), to_u8(c[0][1]), to_u8(c[0][2]));
+        let mut inv_w = [1.0f32; 3];
+        let mut color_w = [[0.0f32; 3]; 3];
+        if smooth {
+            // Perspective weights `E_k / w_k` only matter in ratio. Within
+            // 2^-32..2^32 they are used as they are (products with edge
+            // values stay below 2^91, far from f32 overflow); otherwise
+            // they are rescaled so the largest is 1.
+            let (lo, hi) = (1.0 / 4_294_967_296.0f32, 4_294_967_296.0f32);
+            if iw.iter().all(|&v| v >= lo && v <= hi) {
+                inv_w = iw;
+            } else {
+                let m = iw[0].max(iw[1]).max(iw[2]);
+                inv_w = [iw[0] / m, iw[1] / m, iw[2] / m];
+            }
+            for k in 0..3 {
+                for ch in 0..3 {
+                    color_w[k][ch] = c[k][ch] * inv_w[k];
+                }
+            }
+        }
+        SetupTriangle {
+            x: self.x,
+            y: self.y,
+            z: self.z,
+            area: self.area,
+            min_x: self.bbox[0],
+            max_x: self.bbox[1],
+            min_y: self.bbox[2],
+            max_y: self.bbox[3],
+            inv_w,
+            color_w,
+            flat,
+            smooth,
+            id,
+        }
+    }
 }

@@ -1,0 +1,672 @@
+//! embedded-graphics output: a frame through a strip buffer into any
+//! [`DrawTarget`].
+//!
+//! Design note: a display driver wants whole rectangles of pixels, and the
+//! firmware has RAM for a few rows, not a frame. [`StripDrawer`] holds the
+//! caller's strip buffers (colour, and depth or [`NoDepth`](crate::NoDepth))
+//! and walks a frame top to bottom: for each strip it clears the buffers,
+//! draws the rows into them, and pushes them to the target with **one**
+//! [`DrawTarget::fill_contiguous`] over the strip's rectangle (a display
+//! driver turns that into one address window and one burst of pixel data).
+//! The target's error is handed back unchanged in [`DrawError::Target`];
+//! the renderer's own errors (a buffer too small for one row, a bad frame
+//! size) in [`DrawError::Render`], before anything is drawn.
+//!
+//! Two ways to feed it, the same pixels either way:
+//!
+//! - [`StripDrawer::draw`] is immediate mode: a closure submits the scene to
+//!   a [`StripRenderer`] once per strip. No setup storage at all: the
+//!   RAM-starved path (the Cortex-M0 example renders 320x240 in 16 KB).
+//! - [`StripDrawer::draw_frame`] renders an already set-up [`Frame`], which
+//!   costs setup storage but sets each triangle up once.
+//!
+//! Colours: the strip buffer holds pixels of any [`Pixel`] type `P` and the
+//! target's colour must convert from it (`T::Color: From<P>`). With `P` the
+//! target's own colour (`Rgb565`, `Rgb888`, `Gray8`, `BinaryColor`) that is
+//! the identity, and each fragment was converted once, from the rasterizer's
+//! `Rgb888`, with embedded-graphics' `From<Rgb888>`: `Rgb565` rounds each
+//! channel to 5/6/5 bits (`round(v * 31 / 255)`, `round(v * 63 / 255)`),
+//! `Gray8` is the BT.601 luma, `BinaryColor` is on when that luma is at
+//! least 128. A wider buffer (`Rgb888`) into a narrower target converts at
+//! push time with the same `From`, so the pixels are the same.
+
+use crate::color::Pixel;
+use crate::depth::{DepthBuffer, NoDepth};
+use crate::fixed::SUBPIXEL_BITS;
+use crate::frame::{Config, Error, Frame, RenderStats};
+use crate::immediate::StripRenderer;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
+
+/// What stopped a [`StripDrawer`]: the renderer, or the target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DrawError<E> {
+    /// The renderer refused the frame or the buffers; nothing was drawn.
+    Render(Error),
+    /// The target's own error, from `fill_contiguous`; the strips above
+    /// the failing one were pushed, nothing after it.
+    Target(E),
+}
+
+impl<E> From<Error> for DrawError<E> {
+    fn from(e: Error) -> Self {
+        DrawError::Render(e)
+    }
+}
+
+impl<E: core::fmt::Display> core::fmt::Display for DrawError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            DrawError::Render(e) => write!(f, "render: {e}"),
+            DrawError::Target(e) => write!(f, "draw target: {e}"),
+        }
+    }
+}
+
+impl<E: core::error::Error + 'static> core::error::Error for DrawError<E> {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            DrawError::Render(e) => Some(e),
+            DrawError::Target(e) => Some(e),
+        }
+    }
+}
+
+/// The depth strip of a [`StripDrawer`]: `&mut [u16]`, `&mut [u32]`
+/// (or arrays of them), or [`NoDepth`] by value.
+pub trait StripDepth {
+    /// What the rasterizer draws into: `[u16]`, `[u32]` or [`NoDepth`].
+    type Rows: DepthBuffer + ?Sized;
+
+    /// The number of depth values held, `None` without a buffer.
+    fn held(&self) -> Option<usize>;
+
+    /// The first `len` values, each set to the depth `z32` (`Z32`; a `u16`
+    /// buffer keeps its top 16 bits), or `None` if fewer are held.
+    fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut Self::Rows>;
+}
+
+macro_rules! strip_depth {
+    ($t:ty, $z:expr) => {
+        impl StripDepth for &mut [$t] {
+            type Rows = [$t];
+            fn held(&self) -> Option<usize> {
+                Some(self.len())
+            }
+            fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [$t]> {
+                let rows = self.get_mut(..len)?;
+                rows.fill($z(z32));
+                Some(rows)
+            }
+        }
+
+        impl<const N: usize> StripDepth for &mut [$t; N] {
+            type Rows = [$t];
+            fn held(&self) -> Option<usize> {
+                Some(N)
+            }
+            fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [$t]> {
+                let rows = self.get_mut(..len)?;
+                rows.fill($z(z32));
+                Some(rows)
+            }
+        }
+    };
+}
+
+strip_depth!(u16, |z: u32| (z >> 16) as u16);
+strip_depth!(u32, |z: u32| z);
+
+impl StripDepth for NoDepth {
+    type Rows = NoDepth;
+    fn held(&self) -> Option<usize> {
+        None
+    }
+    fn cleared(&mut self, _: usize, _: u32) -> Option<&mut NoDepth> {
+        Some(self)
+    }
+}
+
+/// Draws frames into a [`DrawTarget`] through a strip buffer of `P` pixels
+/// and a depth strip `D` (`&mut [u16]`, `&mut [u32]` or [`NoDepth`]).
+///
+/// The strip holds `color.len() / width` rows of a frame `width` pixels
+/// wide (the last strip of a frame may be shorter); the depth strip must
+/// hold at least as many values as the colour strip uses. Both are cleared
+/// before each strip: colour to the background, depth to the far plane
+/// (`u32::MAX` in `Z32`, see [`StripDrawer::with_clear_depth`]).
+///
+/// ```
+/// use embedded_graphics::{mock_display::MockDisplay, prelude::Point};
+/// use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
+/// use microraster::{Config, CullMode, StripDrawer, Vec4};
+///
+/// // A 24x16 frame drawn 4 rows at a time: the strip buffers hold 4 rows.
+/// let mut color = [Rgb565::BLACK; 24 * 4];
+/// let mut depth = [0u16; 24 * 4];
+/// let mut drawer = StripDrawer::new(&mut color, &mut depth, Rgb565::BLACK);
+///
+/// let mut display = MockDisplay::<Rgb565>::new(); // fails on overdraw
+/// let mut config = Config::new(24, 16);
+/// config.cull = CullMode::None;
+/// let stats = drawer
+///     .draw(&mut display, config, |strip| {
+///         // Called once per strip: submit the whole scene each time.
+///         let v = |x, y| Vec4::new(x, y, 0.5, 1.0);
+///         strip.push_clip_triangle([v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)], [Rgb888::RED; 3], 0);
+///     })
+///     .unwrap();
+///
+/// // The lower-left half is red; every pixel was pushed exactly once.
+/// assert_eq!(stats.pixels_written, 24 * 16 / 2);
+/// assert_eq!(display.get_pixel(Point::new(0, 15)), Some(Rgb565::RED));
+/// assert_eq!(display.get_pixel(Point::new(23, 0)), Some(Rgb565::BLACK));
+/// ```
+pub struct StripDrawer<'b, P, D> {
+    color: &'b mut [P],
+    depth: D,
+    background: P,
+    clear_z32: u32,
+    origin: Point,
+}
+
+impl<P, D> core::fmt::Debug for StripDrawer<'_, P, D> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("StripDrawer")
+            .field("color_len", &self.color.len())
+            .field("clear_z32", &self.clear_z32)
+            .field("origin", &self.origin)
+            .finish()
+    }
+}
+
+impl<'b, P: Pixel, D: StripDepth> StripDrawer<'b, P, D> {
+    /// A drawer with the strip buffers `color` and `depth` (pass
+    /// `&mut depth` or [`NoDepth`]), clearing colour to
+    /// `background`. Frames land at the target's `(0, 0)`.
+    pub fn new(color: &'b mut [P], depth: D, background: P) -> Self {
+        StripDrawer {
+            color,
+            depth,
+            background,
+            clear_z32: u32::MAX,
+            origin: Point::zero(),
+        }
+    }
+
+    /// Places the frame's top-left pixel at `origin` of the target (what
+    /// falls outside the target is the target's to clip).
+    pub fn with_origin(mut self, origin: Point) -> Self {
+        self.origin = origin;
+        self
+    }
+
+    /// Clears depth to `z32` (`Z32`) instead of the far plane, e.g. `0`
+    /// for [`DepthFunc::Greater`](crate::DepthFunc::Greater).
+    pub fn with_clear_depth(mut self, z32: u32) -> Self {
+        self.clear_z32 = z32;
+        self
+    }
+
+    /// The rows per strip for a frame `width` pixels wide (0 if the colour
+    /// buffer cannot hold one row).
+    pub fn strip_rows(&self, width: u32) -> u32 {
+        match width {
+            0 => 0,
+            w => (self.color.len() / w as usize).min(u32::MAX as usize) as u32,
+        }
+    }
+
+    /// Renders a `config.width x config.height` frame in immediate mode:
+    /// for each strip, `scene` submits every triangle to a
+    /// [`StripRenderer`] for those rows, then the strip is pushed to
+    /// `target`. The scene must submit the same triangles each time.
+    /// Draws at the default [`SUBPIXEL_BITS`]; see
+    /// [`StripDrawer::draw_subpixel`] for 4.
+    pub fn draw<T, F>(
+        &mut self,
+        target: &mut T,
+        config: Config,
+        scene: F,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+        F: FnMut(&mut StripRenderer<'_, P, D::Rows, SUBPIXEL_BITS>),
+    {
+        self.draw_subpixel::<T, F, SUBPIXEL_BITS>(target, config, scene)
+    }
+
+    /// [`StripDrawer::draw`] at `S` subpixel bits (4 or 8).
+    pub fn draw_subpixel<T, F, const S: u32>(
+        &mut self,
+        target: &mut T,
+        config: Config,
+        mut scene: F,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+        F: FnMut(&mut StripRenderer<'_, P, D::Rows, S>),
+    {
+        self.for_each_strip(target, config, |y0, y1, color, depth| {
+            let mut strip = StripRenderer::<P, D::Rows, S>::new(config, y0, y1, color, depth)?;
+            scene(&mut strip);
+            Ok(strip.render_stats())
+        })
+    }
+
+    /// Renders a set-up [`Frame`] strip by strip into `target` (see
+    /// [`Frame::render_rows`]).
+    pub fn draw_frame<T, const S: u32>(
+        &mut self,
+        target: &mut T,
+        frame: &Frame<'_, S>,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+    {
+        self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
+            frame.render_rows(y0, y1, color, depth)
+        })
+    }
+
+    /// The strip loop shared by both modes: check, then per strip clear,
+    /// render (`render(y0, y1, color, depth)`) and push.
+    fn for_each_strip<T, R>(
+        &mut self,
+        target: &mut T,
+        config: Config,
+        mut render: R,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+        R: FnMut(u32, u32, &mut [P], &mut D::Rows) -> Result<RenderStats, Error>,
+    {
+        crate::frame::check_size(&config)?;
+        let (width, height) = (config.width, config.height);
+        let rows = self.strip_rows(width).min(height);
+        let full = width as usize * rows as usize;
+        if rows == 0 {
+            return Err(Error::ColorBufferSize {
+                expected: width as usize,
+                actual: self.color.len(),
+            }
+            .into());
+        }
+        if let Some(actual) = self.depth.held() {
+            if actual < full {
+                return Err(Error::DepthBufferSize {
+                    expected: full,
+                    actual,
+                }
+                .into());
+            }
+        }
+        let mut total = RenderStats::default();
+        let mut y0 = 0;
+        while y0 < height {
+            let y1 = y0.saturating_add(rows).min(height);
+            let len = width as usize * (y1 - y0) as usize;
+            let (Some(color), Some(depth)) = (
+                self.color.get_mut(..len),
+                self.depth.cleared(len, self.clear_z32),
+            ) else {
+                // Unreachable: both were checked to hold `full >= len`.
+                return Err(Error::ColorBufferSize {
+                    expected: len,
+                    actual: self.color.len(),
+                }
+                .into());
+            };
+            color.fill(self.background);
+            let stats = render(y0, y1, color, depth)?;
+            total.pixels_written += stats.pixels_written;
+            let area = Rectangle::new(
+                self.origin + Point::new(0, y0 as i32),
+                Size::new(width, y1 - y0),
+            );
+            target
+                .fill_contiguous(&area, color.iter().map(|&p| T::Color::from(p)))
+                .map_err(DrawError::Target)?;
+            y0 = y1;
+        }
+        Ok(total)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use super::*;
+    use crate::frame::CullMode;
+    use crate::math::Vec4;
+    use crate::setup::SetupTriangle;
+    use embedded_graphics::mock_display::{ColorMapping, MockDisplay};
+    use embedded_graphics_core::pixelcolor::{
+        BinaryColor, Gray8, GrayColor, PixelColor, Rgb565, Rgb888, RgbColor,
+    };
+    use embedded_graphics_core::Pixel as EgPixel;
+    use embedded_graphics_core::{geometry::OriginDimensions, prelude::Dimensions};
+    use std::vec;
+    use std::vec::Vec;
+
+    const W: u32 = 48;
+    const H: u32 = 40;
+
+    fn v(x: f32, y: f32, z: f32) -> Vec4 {
+        Vec4::new(x, y, z, 1.0)
+    }
+
+    /// Overlapping triangles at different depths, one Gouraud, one leaving
+    /// the frame, submitted to anything that takes clip-space triangles.
+    fn scene(mut push: impl FnMut([Vec4; 3], [Rgb888; 3], u32)) {
+        push(
+            [v(-0.9, -0.8, 0.5), v(0.7, -0.9, 0.5), v(-0.2, 0.9, 0.5)],
+            [Rgb888::RED, Rgb888::GREEN, Rgb888::BLUE],
+            0,
+        );
+        push(
+            [v(-0.3, -1.4, 0.2), v(1.3, 0.1, 0.9), v(0.1, 0.7, -0.3)],
+            [Rgb888::YELLOW; 3],
+            1,
+        );
+        push(
+            [v(-1.0, 0.6, 0.0), v(-0.6, 0.1, 0.0), v(-0.4, 1.0, 0.0)],
+            [Rgb888::WHITE; 3],
+            2,
+        );
+    }
+
+    fn config() -> Config {
+        let mut c = Config::new(W, H);
+        c.cull = CullMode::None;
+        c
+    }
+
+    /// The frame rendered in one piece with [`Frame::render_rows`].
+    fn reference<P: Pixel>(background: P) -> Vec<P> {
+        let mut storage = [SetupTriangle::EMPTY; 16];
+        let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
+        scene(|p, c, id| frame.push_clip_triangle(p, c, id).unwrap());
+        let mut color = vec![background; (W * H) as usize];
+        let mut depth = vec![u16::MAX; (W * H) as usize];
+        frame.render_rows(0, H, &mut color, &mut depth[..]).unwrap();
+        color
+    }
+
+    fn expected_display<C: PixelColor>(pixels: &[C], origin: Point) -> MockDisplay<C> {
+        let mut d = MockDisplay::new();
+        for (i, &c) in pixels.iter().enumerate() {
+            let p = Point::new((i as u32 % W) as i32, (i as u32 / W) as i32);
+            d.set_pixel(origin + p, Some(c));
+        }
+        d
+    }
+
+    /// Every strip height, both modes, at an offset: each frame pixel is
+    /// written exactly once (MockDisplay panics on overdraw and outside
+    /// its 64x64), nothing else is, and the pixels equal the one-piece
+    /// render.
+    fn every_pixel_once<P>(background: P)
+    where
+        P: Pixel + PixelColor + ColorMapping + core::fmt::Debug,
+    {
+        let origin = Point::new(5, 11);
+        let expected = expected_display(&reference(background), origin);
+        let mut storage = [SetupTriangle::EMPTY; 16];
+        let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
+        scene(|p, c, id| frame.push_clip_triangle(p, c, id).unwrap());
+        for rows in [1, 3, 7, 16, 39, 40, 64] {
+            let mut color = vec![background; (W * rows) as usize];
+            let mut depth = vec![0u16; (W * rows) as usize];
+            let mut drawer =
+                StripDrawer::new(&mut color, &mut depth[..], background).with_origin(origin);
+            assert_eq!(drawer.strip_rows(W), rows);
+
+            let mut display = MockDisplay::<P>::new();
+            drawer
+                .draw(&mut display, config(), |strip| {
+                    scene(|p, c, id| strip.push_clip_triangle(p, c, id))
+                })
+                .unwrap();
+            display.assert_eq_with_message(&expected, |f| write!(f, "immediate, {rows} rows"));
+            assert_eq!(
+                display.affected_area(),
+                Rectangle::new(origin, Size::new(W, H))
+            );
+
+            let mut display = MockDisplay::<P>::new();
+            drawer.draw_frame(&mut display, &frame).unwrap();
+            display.assert_eq_with_message(&expected, |f| write!(f, "frame, {rows} rows"));
+        }
+    }
+
+    #[test]
+    fn rgb565_every_pixel_once_for_any_strip_height() {
+        every_pixel_once(Rgb565::BLACK);
+    }
+
+    #[test]
+    fn rgb888_every_pixel_once_for_any_strip_height() {
+        every_pixel_once(Rgb888::new(1, 2, 3));
+    }
+
+    #[test]
+    fn gray8_every_pixel_once_for_any_strip_height() {
+        every_pixel_once(Gray8::BLACK);
+    }
+
+    #[test]
+    fn binary_every_pixel_once_for_any_strip_height() {
+        every_pixel_once(BinaryColor::Off);
+    }
+
+    /// A wider strip buffer converts at push time to the same pixels as a
+    /// buffer of the target's colour.
+    #[test]
+    fn rgb888_buffer_into_narrower_targets_converts_like_from() {
+        let rgb = reference(Rgb888::BLACK);
+        let mut color = vec![Rgb888::BLACK; (W * 8) as usize];
+        let mut depth = vec![0u16; (W * 8) as usize];
+        let mut drawer = StripDrawer::new(&mut color, &mut depth[..], Rgb888::BLACK);
+        let submit = |strip: &mut StripRenderer<'_, Rgb888, [u16]>| {
+            scene(|p, c, id| strip.push_clip_triangle(p, c, id))
+        };
+
+        let mut d565 = MockDisplay::<Rgb565>::new();
+        drawer.draw(&mut d565, config(), submit).unwrap();
+        let want: Vec<Rgb565> = reference(Rgb565::BLACK);
+        d565.assert_eq(&expected_display(&want, Point::zero()));
+        assert_eq!(
+            want,
+            rgb.iter().map(|&c| Rgb565::from(c)).collect::<Vec<_>>()
+        );
+
+        let mut gray = MockDisplay::<Gray8>::new();
+        drawer.draw(&mut gray, config(), submit).unwrap();
+        gray.assert_eq(&expected_display(&reference(Gray8::BLACK), Point::zero()));
+
+        let mut bin = MockDisplay::<BinaryColor>::new();
+        drawer.draw(&mut bin, config(), submit).unwrap();
+        bin.assert_eq(&expected_display(
+            &reference(BinaryColor::Off),
+            Point::zero(),
+        ));
+    }
+
+    /// The fill rule through the adapter, as a picture (strips of 4 rows,
+    /// so the frame is pushed as 4 + 2): a right triangle whose edges all
+    /// run through pixel centres keeps its top edge (row 0) and its
+    /// diagonal (a left edge) and drops its vertical right edge (column 6).
+    #[test]
+    fn binary_pattern() {
+        let mut config = Config::new(8, 6);
+        config.cull = CullMode::None;
+        let mut color = [BinaryColor::Off; 8 * 4];
+        let mut drawer = StripDrawer::new(&mut color, NoDepth, BinaryColor::Off);
+        let mut display = MockDisplay::<BinaryColor>::new();
+        drawer
+            .draw(&mut display, config, |strip| {
+                // Window (px, py) of an 8x6 frame in NDC: x = -1 + px / 4,
+                // y = 1 - py / 3.
+                let p = |px: f32, py: f32| v(-1.0 + px / 4.0, 1.0 - py / 3.0, 0.0);
+                strip.push_clip_triangle(
+                    [p(0.5, 0.5), p(6.5, 0.5), p(6.5, 6.5)],
+                    [Rgb888::WHITE; 3],
+                    0,
+                );
+            })
+            .unwrap();
+        display.assert_pattern(&[
+            "######..", //
+            ".#####..", //
+            "..####..", //
+            "...###..", //
+            "....##..", //
+            ".....#..", //
+        ]);
+    }
+
+    /// A target that fails on its `n`-th strip.
+    struct Failing {
+        strips: u32,
+        fail_at: u32,
+    }
+
+    impl OriginDimensions for Failing {
+        fn size(&self) -> Size {
+            Size::new(W, H)
+        }
+    }
+
+    impl DrawTarget for Failing {
+        type Color = Gray8;
+        type Error = &'static str;
+        fn draw_iter<I: IntoIterator<Item = EgPixel<Gray8>>>(
+            &mut self,
+            _: I,
+        ) -> Result<(), Self::Error> {
+            Err("draw_iter is not used")
+        }
+        fn fill_contiguous<I: IntoIterator<Item = Gray8>>(
+            &mut self,
+            area: &Rectangle,
+            colors: I,
+        ) -> Result<(), Self::Error> {
+            assert_eq!(area.size.width, W);
+            assert_eq!(
+                colors.into_iter().count() as u32,
+                area.size.width * area.size.height
+            );
+            self.strips += 1;
+            if self.strips == self.fail_at {
+                Err("display unplugged")
+            } else {
+                Ok(())
+            }
+        }
+    }
+
+    #[test]
+    fn target_error_is_passed_through_and_stops_the_frame() {
+        let mut color = [Gray8::BLACK; W as usize * 8];
+        let mut drawer = StripDrawer::new(&mut color, NoDepth, Gray8::BLACK);
+        let mut target = Failing {
+            strips: 0,
+            fail_at: 2,
+        };
+        let mut calls = 0;
+        let r = drawer.draw(&mut target, config(), |strip| {
+            calls += 1;
+            scene(|p, c, id| strip.push_clip_triangle(p, c, id));
+        });
+        assert_eq!(r, Err(DrawError::Target("display unplugged")));
+        assert_eq!((target.strips, calls), (2, 2));
+        assert_eq!(target.bounding_box().size, Size::new(W, H));
+
+        let mut target = Failing {
+            strips: 0,
+            fail_at: 0,
+        };
+        let stats = drawer.draw(&mut target, config(), |_| {}).unwrap();
+        assert_eq!((target.strips, stats.pixels_written), (5, 0));
+    }
+
+    #[test]
+    fn render_errors_come_first_and_draw_nothing() {
+        let mut target = Failing {
+            strips: 0,
+            fail_at: 0,
+        };
+        // Less than one row of colour.
+        let mut color = [Gray8::BLACK; W as usize - 1];
+        let mut drawer = StripDrawer::new(&mut color, NoDepth, Gray8::BLACK);
+        assert_eq!(
+            drawer.draw(&mut target, config(), |_| {}),
+            Err(DrawError::Render(Error::ColorBufferSize {
+                expected: W as usize,
+                actual: W as usize - 1
+            }))
+        );
+        // A depth strip shorter than the colour strip.
+        let mut color = [Gray8::BLACK; W as usize * 4];
+        let mut depth = [0u32; W as usize * 3];
+        let mut drawer = StripDrawer::new(&mut color, &mut depth[..], Gray8::BLACK);
+        assert_eq!(
+            drawer.draw(&mut target, config(), |_| {}),
+            Err(DrawError::Render(Error::DepthBufferSize {
+                expected: W as usize * 4,
+                actual: W as usize * 3
+            }))
+        );
+        // A bad frame size.
+        let mut color = [Gray8::BLACK; 64];
+        let mut drawer = StripDrawer::new(&mut color, NoDepth, Gray8::BLACK);
+        assert!(matches!(
+            drawer.draw(&mut target, Config::new(0, 4), |_| {}),
+            Err(DrawError::Render(Error::InvalidFrameSize { .. }))
+        ));
+        assert_eq!(target.strips, 0);
+    }
+
+    /// `with_clear_depth(0)` with `Greater` draws what `Less` with the far
+    /// clear draws for mirrored depths.
+    #[test]
+    fn clear_depth_for_greater() {
+        let mut c = config();
+        c.depth_func = crate::DepthFunc::Greater;
+        let mut color = vec![Rgb565::BLACK; (W * 5) as usize];
+        let mut depth = vec![0u32; (W * 5) as usize];
+        let mut drawer =
+            StripDrawer::new(&mut color, &mut depth[..], Rgb565::BLACK).with_clear_depth(0);
+        let mut display = MockDisplay::<Rgb565>::new();
+        drawer
+            .draw(&mut display, c, |strip| {
+                scene(|p, col, id| {
+                    // Mirror z about 0 so the nearest stays in front.
+                    strip.push_clip_triangle(p.map(|q| Vec4::new(q.x, q.y, -q.z, q.w)), col, id)
+                })
+            })
+            .unwrap();
+        display.assert_eq(&expected_display(&reference(Rgb565::BLACK), Point::zero()));
+    }
+
+    #[test]
+    fn display_of_errors() {
+        let e: DrawError<&str> = Error::InvalidFrameSize {
+            width: 0,
+            height: 1,
+        }
+        .into();
+        assert!(std::format!("{e}").starts_with("render: invalid frame size"));
+        assert_eq!(
+            std::format!("{}", DrawError::<&str>::Target("x")),
+            "draw target: x"
+        );
+    }
+}
