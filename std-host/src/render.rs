@@ -14,8 +14,8 @@
 use crate::cliptris::ClipTri;
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::{
-    BoundingSphere, ClipVertex, Config, CullMode, DepthBuffer, Error, Frame, Mat4, Mesh,
-    MeshColors, NoDepth, Pixel, SetupTriangle, Stats, TriangleId, Vec3, Vec4,
+    Bins, BoundingSphere, ClipVertex, Config, CullMode, DepthBuffer, Error, Frame, Mat4, Mesh,
+    MeshColors, NoDepth, Pixel, ProcessedVertex, SetupTriangle, Stats, TriangleId, Vec3, Vec4,
 };
 use std::sync::Mutex;
 use std::time::Instant;
@@ -277,54 +277,233 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
     }
 }
 
-/// Pushes every triangle of `scene` into `frame`.
-fn fill<const S: u32>(frame: &mut Frame<'_, S>, scene: &Scene) -> Result<(), Error> {
+/// One piece of a scene's triangle sequence: triangles `range` of object
+/// `object`, or clip-space triangles `range`.
+#[derive(Clone, Debug)]
+enum Piece {
+    Object(usize, std::ops::Range<usize>),
+    ClipTris(std::ops::Range<usize>),
+}
+
+/// Splits the scene's triangle sequence into `parts` contiguous chunks of
+/// about equal size, in drawing order.
+fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
+    let total = scene.triangle_count().max(1);
+    let per = total.div_ceil(parts.max(1)).max(1);
+    let mut chunks: Vec<Vec<Piece>> = vec![Vec::new()];
+    let mut room = per;
+    let mut push = |len: usize, make: &dyn Fn(std::ops::Range<usize>) -> Piece| {
+        let mut start = 0;
+        while start < len {
+            if room == 0 {
+                chunks.push(Vec::new());
+                room = per;
+            }
+            let take = room.min(len - start);
+            if let Some(c) = chunks.last_mut() {
+                c.push(make(start..start + take));
+            }
+            start += take;
+            room -= take;
+        }
+    };
+    for (i, o) in scene.objects.iter().enumerate() {
+        push(o.indices.len(), &|r| Piece::Object(i, r));
+    }
+    push(scene.clip_tris.len(), &|r| Piece::ClipTris(r));
+    chunks
+}
+
+/// The first triangle id of each object, and of the clip-space triangles.
+fn first_ids(scene: &Scene) -> (Vec<u32>, u32) {
+    let mut ids = Vec::with_capacity(scene.objects.len());
     let mut id = 0u32;
     for o in &scene.objects {
-        frame.draw_mesh(&o.mesh(), &o.mvp, id)?;
+        ids.push(id);
         id = id.wrapping_add(o.indices.len() as u32);
     }
-    for t in &scene.clip_tris {
-        let [r, g, b] = t.color.unwrap_or([255, 255, 255]);
-        let color = [r as f32, g as f32, b as f32];
-        let v = t.v.map(|p| ClipVertex {
-            pos: Vec4::from_array(p),
-            color,
-        });
-        frame.push_triangle(v, id)?;
-        id = id.wrapping_add(1);
+    (ids, id)
+}
+
+/// Pushes the triangles of `pieces` into `frame`. Objects use the vertex
+/// cache `caches[i]` (already processed), or are skipped whole when their
+/// bounding sphere is outside the frustum.
+fn fill<const S: u32>(
+    frame: &mut Frame<'_, S>,
+    scene: &Scene,
+    pieces: &[Piece],
+    caches: &[Option<Vec<ProcessedVertex>>],
+) -> Result<(), Error> {
+    let (ids, clip_first) = first_ids(scene);
+    for piece in pieces {
+        match piece {
+            Piece::Object(i, r) => {
+                let o = &scene.objects[*i];
+                let mut mesh = o.mesh();
+                mesh.indices = &o.indices[r.clone()];
+                if let ObjectColors::PerTriangle(c) = &o.colors {
+                    mesh.colors = MeshColors::PerTriangle(&c[r.clone()]);
+                }
+                let id = ids[*i].wrapping_add(r.start as u32);
+                match &caches[*i] {
+                    Some(cache) => frame.draw_mesh_processed(&mesh, id, cache)?,
+                    // Culled by its bounding sphere: counted, nothing else.
+                    None => frame.draw_mesh(&mesh, &o.mvp, id)?,
+                }
+            }
+            Piece::ClipTris(r) => {
+                for (k, t) in scene.clip_tris[r.clone()].iter().enumerate() {
+                    let [cr, cg, cb] = t.color.unwrap_or([255, 255, 255]);
+                    let color = [cr as f32, cg as f32, cb as f32];
+                    let v = t.v.map(|p| ClipVertex {
+                        pos: Vec4::from_array(p),
+                        color,
+                    });
+                    let id = clip_first.wrapping_add((r.start + k) as u32);
+                    frame.push_triangle(v, id)?;
+                }
+            }
+        }
     }
     Ok(())
+}
+
+/// Runs the vertex stage of every visible object, `threads` workers per
+/// object; `None` for an object outside the frustum.
+fn process_objects<const S: u32>(
+    scene: &Scene,
+    config: Config,
+    threads: usize,
+) -> Result<Vec<Option<Vec<ProcessedVertex>>>, String> {
+    let probe = Frame::<S>::new(config, &mut []).map_err(|e| e.to_string())?;
+    let mut caches = Vec::with_capacity(scene.objects.len());
+    for o in &scene.objects {
+        if o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
+            caches.push(None);
+            continue;
+        }
+        let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
+        let chunk = o.positions.len().div_ceil(threads.max(1)).max(4096);
+        std::thread::scope(|s| {
+            for (p, c) in o.positions.chunks(chunk).zip(cache.chunks_mut(chunk)) {
+                let probe = &probe;
+                s.spawn(move || probe.process_vertices(&o.mvp, p, c));
+            }
+        });
+        caches.push(Some(cache));
+    }
+    Ok(caches)
+}
+
+/// Builds one frame per chunk of the scene (in parallel), each in its own
+/// storage; drawn in order they are the scene.
+fn build_frames<'s, const S: u32>(
+    scene: &Scene,
+    config: Config,
+    chunks: &[Vec<Piece>],
+    caches: &[Option<Vec<ProcessedVertex>>],
+    storages: &'s mut [Vec<SetupTriangle>],
+) -> Result<Vec<Frame<'s, S>>, String> {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = storages
+            .iter_mut()
+            .zip(chunks)
+            .map(|(storage, pieces)| {
+                s.spawn(move || -> Result<Frame<'s, S>, String> {
+                    // Grow the storage until the chunk fits (clipping can
+                    // turn one triangle into several; the first guess
+                    // almost always suffices).
+                    loop {
+                        let needed = {
+                            let mut f =
+                                Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
+                            match fill(&mut f, scene, pieces, caches) {
+                                Ok(()) => 0,
+                                Err(Error::StorageFull { needed, .. }) => needed,
+                                Err(e) => return Err(e.to_string()),
+                            }
+                        };
+                        if needed == 0 {
+                            break;
+                        }
+                        let grow = needed.max(storage.len() / 2);
+                        storage.resize(storage.len() + grow, SetupTriangle::EMPTY);
+                    }
+                    let mut f = Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
+                    fill(&mut f, scene, pieces, caches).map_err(|e| e.to_string())?;
+                    Ok(f)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err("setup worker failed".into()))
+            })
+            .collect()
+    })
 }
 
 fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
+    let threads = opts.threads.max(1);
     let t0 = Instant::now();
-    let n = scene.triangle_count();
-    let mut storage = vec![SetupTriangle::EMPTY; n + n / 8 + 64];
-    // Grow the storage until the frame fits (clipping can turn one triangle
-    // into several; the first guess almost always suffices).
-    loop {
-        let needed = {
-            let mut frame = Frame::<S>::new(config, &mut storage).map_err(|e| e.to_string())?;
-            match fill(&mut frame, scene) {
-                Ok(()) => 0,
-                Err(Error::StorageFull { needed, .. }) => needed,
-                Err(e) => return Err(e.to_string()),
-            }
-        };
-        if needed == 0 {
-            break;
-        }
-        let grow = needed.max(storage.len() / 2);
-        storage.resize(storage.len() + grow, SetupTriangle::EMPTY);
+    // Set up in parallel only where there is enough work to share.
+    let parts = if scene.triangle_count() >= 20_000 {
+        threads
+    } else {
+        1
+    };
+    let caches = process_objects::<S>(scene, config, threads)?;
+    let chunks = partition(scene, parts);
+    let mut storages: Vec<Vec<SetupTriangle>> = chunks
+        .iter()
+        .map(|pieces| {
+            let n: usize = pieces
+                .iter()
+                .map(|p| match p {
+                    Piece::Object(_, r) | Piece::ClipTris(r) => r.len(),
+                })
+                .sum();
+            vec![SetupTriangle::EMPTY; n + n / 8 + 64]
+        })
+        .collect();
+    let frames = build_frames::<S>(scene, config, &chunks, &caches, &mut storages)?;
+    let mut stats = Stats::default();
+    for f in &frames {
+        let s = f.stats();
+        stats.submitted += s.submitted;
+        stats.culled_object += s.culled_object;
+        stats.culled_frustum += s.culled_frustum;
+        stats.culled_backface += s.culled_backface;
+        stats.culled_degenerate += s.culled_degenerate;
+        stats.rejected_nonfinite += s.rejected_nonfinite;
+        stats.rejected_index += s.rejected_index;
+        stats.clipped += s.clipped;
+        stats.stored += s.stored;
     }
-    // Build it again into the storage that fits (only after a retry is this
-    // repeated work; the loop above usually runs once).
-    let mut frame = Frame::<S>::new(config, &mut storage).map_err(|e| e.to_string())?;
-    fill(&mut frame, scene).map_err(|e| e.to_string())?;
+    // Bin every frame's triangles by strip.
+    let strip_rows = opts.strip_rows.max(1);
+    let strips = h.div_ceil(strip_rows) as usize;
+    let mut bin_store: Vec<(Vec<u32>, Vec<u32>)> = frames
+        .iter()
+        .map(|f| {
+            (
+                vec![0u32; strips + 1],
+                vec![0u32; f.bin_entries(strip_rows)],
+            )
+        })
+        .collect();
+    let bins = frames
+        .iter()
+        .zip(bin_store.iter_mut())
+        .map(|(f, (o, i))| f.bin(strip_rows, o, i))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let layers: Vec<(&Frame<'_, S>, &Bins<'_>)> = frames.iter().zip(bins.iter()).collect();
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let len = w as usize * h as usize;
@@ -334,7 +513,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
         DepthKind::U16 => {
             let mut d = vec![u16::MAX; len];
             let px = render_strips(
-                &frame,
+                &layers,
                 &mut color,
                 Some(&mut d[..]),
                 BACKGROUND,
@@ -346,7 +525,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
         DepthKind::U32 => {
             let mut d = vec![u32::MAX; len];
             let px = render_strips(
-                &frame,
+                &layers,
                 &mut color,
                 Some(&mut d[..]),
                 BACKGROUND,
@@ -356,7 +535,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
             (DepthImage::U32(d), px)
         }
         DepthKind::None => {
-            let px = render_strips::<S, _, u32>(&frame, &mut color, None, BACKGROUND, 0, opts)?;
+            let px = render_strips::<S, _, u32>(&layers, &mut color, None, BACKGROUND, 0, opts)?;
             (DepthImage::None, px)
         }
     };
@@ -369,7 +548,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
             DepthKind::U16 => {
                 let mut d = vec![u16::MAX; len];
                 render_strips(
-                    &frame,
+                    &layers,
                     &mut ids,
                     Some(&mut d[..]),
                     TriangleId(0),
@@ -380,7 +559,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
             DepthKind::U32 => {
                 let mut d = vec![u32::MAX; len];
                 render_strips(
-                    &frame,
+                    &layers,
                     &mut ids,
                     Some(&mut d[..]),
                     TriangleId(0),
@@ -389,7 +568,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
                 )?
             }
             DepthKind::None => {
-                render_strips::<S, _, u32>(&frame, &mut ids, None, TriangleId(0), 0, opts)?
+                render_strips::<S, _, u32>(&layers, &mut ids, None, TriangleId(0), 0, opts)?
             }
         };
         Some(ids.into_iter().map(|t| t.0).collect())
@@ -405,7 +584,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
         rgb,
         ids,
         depth,
-        stats: frame.stats(),
+        stats,
         pixels_written,
         timings: Timings {
             setup_ms,
@@ -415,13 +594,14 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
     })
 }
 
-/// One strip of work: its first row and its rows of colour and depth.
+/// One strip of work: its index and its rows of colour and depth.
 type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
 
 /// Clears and renders every strip of `color` (and `depth`) on
-/// `opts.threads` workers. Returns the pixels written.
+/// `opts.threads` workers, drawing the binned frames `layers` in order.
+/// Returns the pixels written.
 fn render_strips<const S: u32, C, T>(
-    frame: &Frame<'_, S>,
+    layers: &[(&Frame<'_, S>, &Bins<'_>)],
     color: &mut [C],
     depth: Option<&mut [T]>,
     clear_color: C,
@@ -440,12 +620,12 @@ where
     match depth {
         Some(d) => {
             for (i, (c, d)) in color.chunks_mut(chunk).zip(d.chunks_mut(chunk)).enumerate() {
-                work.push(((i * rows) as u32, c, Some(d)));
+                work.push((i as u32, c, Some(d)));
             }
         }
         None => {
             for (i, c) in color.chunks_mut(chunk).enumerate() {
-                work.push(((i * rows) as u32, c, None));
+                work.push((i as u32, c, None));
             }
         }
     }
@@ -461,16 +641,18 @@ where
                             Ok(mut q) => q.next(),
                             Err(poisoned) => poisoned.into_inner().next(),
                         };
-                        let Some((y0, c, d)) = item else { break };
-                        let y1 = y0 + (c.len() / width) as u32;
+                        let Some((strip, c, mut d)) = item else { break };
                         c.fill(clear_color);
-                        written += match d {
-                            Some(d) => {
-                                d.fill(clear_depth);
-                                frame.render_rows(y0, y1, c, d)?.pixels_written
+                        if let Some(d) = d.as_deref_mut() {
+                            d.fill(clear_depth);
+                        }
+                        for (frame, bins) in layers {
+                            written += match d.as_deref_mut() {
+                                Some(d) => frame.render_strip(bins, strip, c, d)?,
+                                None => frame.render_strip(bins, strip, c, &mut NoDepth)?,
                             }
-                            None => frame.render_rows(y0, y1, c, &mut NoDepth)?.pixels_written,
-                        };
+                            .pixels_written;
+                        }
                     }
                     Ok(written)
                 })
