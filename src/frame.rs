@@ -572,11 +572,35 @@ impl<'s, const S: u32> Frame<'s, S> {
                 return Ok(());
             }
         }
-        let c = self.config;
+        self.process_vertices(mvp, mesh.positions, cache);
+        self.draw_mesh_processed(mesh, first_id, cache)
+    }
+
+    /// The vertex stage of [`Frame::draw_mesh_cached`] alone: transforms,
+    /// outcodes and snaps `positions` into `out` (pairwise; extra entries of
+    /// either are left alone). Chunks of one mesh's vertices can be
+    /// processed in parallel, by frames of the same configuration, before
+    /// [`Frame::draw_mesh_processed`].
+    pub fn process_vertices(&self, mvp: &Mat4, positions: &[Vec3], out: &mut [ProcessedVertex]) {
+        let c = &self.config;
         let (gx, gy) = self.guard;
-        for (p, v) in mesh.positions.iter().zip(cache.iter_mut()) {
+        for (p, v) in positions.iter().zip(out.iter_mut()) {
             *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
         }
+    }
+
+    /// The triangle stage of [`Frame::draw_mesh_cached`]: submits the
+    /// triangles of `mesh` whose vertices `cache` holds already processed
+    /// by [`Frame::process_vertices`] for a frame of this configuration
+    /// (entry `i` for `mesh.positions[i]`; `mesh.bounds` is not tested
+    /// here). All-or-nothing on [`Error::StorageFull`].
+    pub fn draw_mesh_processed(
+        &mut self,
+        mesh: &Mesh<'_>,
+        first_id: u32,
+        cache: &[ProcessedVertex],
+    ) -> Result<(), Error> {
+        let c = self.config;
         let start_len = self.len;
         let start_stats = self.stats;
         let mut stats = Stats::default();
