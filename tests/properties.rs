@@ -1,0 +1,975 @@
+//! Property tests (proptest). Case counts default to at least 256 per
+//! property and follow `PROPTEST_CASES` when it is set.
+//!
+//! - Coverage equals the exact reference rasterizer for random triangles on
+//!   the subpixel grid and off it, at S = 4 and 8, both windings, slivers,
+//!   tiny and huge (guard-band) triangles; with culling, exactly the right
+//!   windings are drawn.
+//! - Any split into strips renders the identical frame (colour, ids, u16
+//!   and u32 depth), bit for bit.
+//! - Closed fans cover every pixel strictly inside once and nothing twice.
+//! - Moving a scene by whole pixels moves its images and nothing else.
+//! - `Stats`: every submitted triangle is stored or counted exactly once.
+
+mod common;
+
+use common::*;
+use microraster::clip::outcode;
+use microraster::fixed::guard_band_ndc;
+use microraster::pixelcolor::Rgb888;
+use microraster::{
+    ClipVertex, Config, CullMode, DepthFunc, Error, Frame, FrontFace, Mat4, Mesh, MeshColors,
+    NoDepth, ProcessedVertex, Stats, StripRenderer, TriangleId, Vec3, Vec4,
+};
+use proptest::prelude::*;
+
+// ---------------------------------------------------------------------------
+// Strategies
+// ---------------------------------------------------------------------------
+
+/// Power-of-two frame sizes 1..=64 (exact window-to-clip conversion).
+fn pow2_size() -> impl Strategy<Value = (u32, u32)> {
+    (0u32..=6, 0u32..=6).prop_map(|(a, b)| (1 << a, 1 << b))
+}
+
+/// A triangle with vertices on the `Sub<s>` grid of a `w x h` frame, of a
+/// random kind: general, small, tiny, sliver, on the half-pixel lattice
+/// (many centres exactly on edges), axis-aligned edges, or huge (far
+/// off-screen, up to 2^20 units).
+fn grid_tri(s: u32, w: u32, h: u32) -> BoxedStrategy<[SubPt; 3]> {
+    let one = 1i64 << s;
+    let (fw, fh) = ((w as i64) << s, (h as i64) << s);
+    let m = 3 * one;
+    let pt = move || (-m..fw + m, -m..fh + m);
+    let general = (pt(), pt(), pt()).prop_map(|(a, b, c)| [a, b, c]);
+    let small = (
+        pt(),
+        (-3 * one..=3 * one, -3 * one..=3 * one),
+        (-3 * one..=3 * one, -3 * one..=3 * one),
+    )
+        .prop_map(|(a, d1, d2)| [a, (a.0 + d1.0, a.1 + d1.1), (a.0 + d2.0, a.1 + d2.1)]);
+    let tiny = (pt(), (-one..=one, -one..=one), (-one..=one, -one..=one))
+        .prop_map(|(a, d1, d2)| [a, (a.0 + d1.0, a.1 + d1.1), (a.0 + d2.0, a.1 + d2.1)]);
+    let sliver = (pt(), pt(), -8i64..=24, (-3i64..=3, -3i64..=3)).prop_map(|(a, b, t, d)| {
+        let c = (
+            a.0 + (b.0 - a.0) * t / 16 + d.0,
+            a.1 + (b.1 - a.1) * t / 16 + d.1,
+        );
+        [a, b, c]
+    });
+    let half = one / 2;
+    let hw = 2 * w as i64 + 6;
+    let hh = 2 * h as i64 + 6;
+    let lattice = ((-3..hw, -3..hh), (-3..hw, -3..hh), (-3..hw, -3..hh))
+        .prop_map(move |(a, b, c)| [a, b, c].map(|p| (p.0 * half, p.1 * half)));
+    let axis = (pt(), pt(), any::<bool>()).prop_map(|(a, b, vertical)| {
+        let c = if vertical { (a.0, b.1) } else { (b.0, a.1) };
+        [a, b, c]
+    });
+    let big = 1i64 << 20;
+    let huge =
+        ((-big..big, -big..big), (-big..big, -big..big), pt()).prop_map(|(a, b, c)| [a, b, c]);
+    prop_oneof![
+        3 => general,
+        2 => small,
+        1 => tiny,
+        2 => sliver,
+        2 => lattice,
+        1 => axis,
+        1 => huge,
+    ]
+    .boxed()
+}
+
+/// Clip-space vertices (w = 1) that snap exactly to the grid points `v`.
+fn grid_to_clip(v: [SubPt; 3], s: u32, w: u32, h: u32) -> [Vec4; 3] {
+    let u = (1u64 << s) as f64;
+    v.map(|(x, y)| wv(x as f64 / u, y as f64 / u, w, h))
+}
+
+/// Off-grid clip-space triangles: NDC positions (within 0.9 of the guard
+/// band, so the core does not clip) times a random w per vertex, z inside
+/// [-w, w]. Kinds: in and around the frame, small, sliver, huge.
+fn clip_tri(gx: f32, gy: f32) -> BoxedStrategy<[Vec4; 3]> {
+    let wv = || prop_oneof![Just(1.0f32), 0.1f32..8.0];
+    let vtx = move |r: f32| {
+        let (lx, ly) = (r.min(gx * 0.9), r.min(gy * 0.9));
+        (-lx..=lx, -ly..=ly, -1.0f32..=1.0, wv())
+            .prop_map(|(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w))
+    };
+    let near = (vtx(1.3), vtx(1.3), vtx(1.3)).prop_map(|(a, b, c)| [a, b, c]);
+    let huge = (vtx(1.0e6), vtx(1.0e6), vtx(1.3)).prop_map(|(a, b, c)| [a, b, c]);
+    let small = (
+        vtx(1.1),
+        (-0.1f32..0.1, -0.1f32..0.1),
+        (-0.1f32..0.1, -0.1f32..0.1),
+    )
+        .prop_map(|(a, d1, d2)| {
+            let p = |d: (f32, f32)| Vec4::new(a.x + d.0 * a.w, a.y + d.1 * a.w, a.z, a.w);
+            [a, p(d1), p(d2)]
+        });
+    let sliver = (vtx(1.3), vtx(1.3), -0.5f32..1.5, -1e-3f32..1e-3).prop_map(|(a, b, t, e)| {
+        let (ax, ay) = (a.x / a.w, a.y / a.w);
+        let (bx, by) = (b.x / b.w, b.y / b.w);
+        let c = Vec4::new(ax + (bx - ax) * t + e, ay + (by - ay) * t - e, 0.0, 1.0);
+        [a, b, c]
+    });
+    prop_oneof![3 => near, 1 => huge, 2 => small, 2 => sliver].boxed()
+}
+
+/// Per-vertex colours.
+fn colors() -> impl Strategy<Value = [Rgb888; 3]> {
+    prop::array::uniform3(
+        (any::<u8>(), any::<u8>(), any::<u8>()).prop_map(|(r, g, b)| Rgb888::new(r, g, b)),
+    )
+}
+
+// ---------------------------------------------------------------------------
+// Coverage vs the reference
+// ---------------------------------------------------------------------------
+
+fn check_coverage<const S: u32>(config: Config, pos: [Vec4; 3]) -> Result<(), TestCaseError> {
+    let (w, h) = (config.width, config.height);
+    let expected = match snap_tri::<S>(&pos, w, h) {
+        Some(v) => reference_coverage(v, S, w, h),
+        None => vec![false; (w * h) as usize],
+    };
+    for order in [pos, [pos[0], pos[2], pos[1]]] {
+        let got = coverage::<S>(config, order);
+        if got != expected {
+            let diff: Vec<usize> = (0..got.len()).filter(|&k| got[k] != expected[k]).collect();
+            return Err(TestCaseError::fail(format!(
+                "S={S} {w}x{h} {order:?}: {} pixels differ, first at ({}, {}) (core {}, reference {}); snapped {:?}",
+                diff.len(),
+                diff[0] as u32 % w,
+                diff[0] as u32 / w,
+                got[diff[0]],
+                expected[diff[0]],
+                snap_tri::<S>(&order, w, h)
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn grid_case(s: u32) -> impl Strategy<Value = (u32, u32, [SubPt; 3])> {
+    pow2_size().prop_flat_map(move |(w, h)| (Just(w), Just(h), grid_tri(s, w, h)))
+}
+
+fn clip_case<const S: u32>() -> impl Strategy<Value = (u32, u32, [Vec4; 3])> {
+    (1u32..=40, 1u32..=40).prop_flat_map(|(w, h)| {
+        let (gx, gy) = guard_band_ndc::<S>(w, h);
+        (Just(w), Just(h), clip_tri(gx, gy))
+    })
+}
+
+proptest! {
+    #![proptest_config(cases(2048))]
+
+    /// Vertices on the 1/256 grid: coverage equals the reference exactly.
+    #[test]
+    fn coverage_matches_reference_on_grid_s8((w, h, v) in grid_case(8)) {
+        let pos = grid_to_clip(v, 8, w, h);
+        prop_assert_eq!(snap_tri::<8>(&pos, w, h), Some(v), "construction must be exact");
+        check_coverage::<8>(config_nocull(w, h), pos)?;
+    }
+
+    /// Vertices on the 1/16 grid: coverage equals the reference exactly.
+    #[test]
+    fn coverage_matches_reference_on_grid_s4((w, h, v) in grid_case(4)) {
+        let pos = grid_to_clip(v, 4, w, h);
+        prop_assert_eq!(snap_tri::<4>(&pos, w, h), Some(v), "construction must be exact");
+        check_coverage::<4>(config_nocull(w, h), pos)?;
+    }
+
+    /// Random f32 clip coordinates (any w > 0, no clipping needed): the
+    /// core's coverage equals the reference run on `fixed::snap`'s output.
+    #[test]
+    fn coverage_matches_reference_off_grid_s8((w, h, pos) in clip_case::<8>()) {
+        check_coverage::<8>(config_nocull(w, h), pos)?;
+    }
+
+    /// As above at 4 subpixel bits.
+    #[test]
+    fn coverage_matches_reference_off_grid_s4((w, h, pos) in clip_case::<4>()) {
+        check_coverage::<4>(config_nocull(w, h), pos)?;
+    }
+
+    /// With culling, a triangle is drawn (exactly as the reference) iff its
+    /// winding survives; counter-clockwise in NDC means clockwise in
+    /// window space (y down).
+    #[test]
+    fn culling_keeps_exactly_the_right_windings(
+        (w, h, v) in grid_case(8),
+        cull in prop_oneof![Just(CullMode::Back), Just(CullMode::Front), Just(CullMode::None)],
+        front in prop_oneof![Just(FrontFace::Ccw), Just(FrontFace::Cw)],
+    ) {
+        let pos = grid_to_clip(v, 8, w, h);
+        let mut cfg = Config::new(w, h);
+        cfg.cull = cull;
+        cfg.front_face = front;
+        let area = orient(v[0], v[1], v[2]);
+        let ccw_ndc = area < 0;
+        let is_front = (front == FrontFace::Ccw) == ccw_ndc;
+        let drawn = match cull {
+            CullMode::None => true,
+            CullMode::Back => is_front,
+            CullMode::Front => !is_front,
+        };
+        let expected = if drawn {
+            reference_coverage(v, 8, w, h)
+        } else {
+            vec![false; (w * h) as usize]
+        };
+        prop_assert_eq!(coverage::<8>(cfg, pos), expected);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Strip invariance
+// ---------------------------------------------------------------------------
+
+/// A scene: clip-space triangles (some crossing the near/far planes or the
+/// frame edges) with Gouraud colours.
+/// A frame size and its coloured triangles.
+type Scene = (u32, u32, Vec<([Vec4; 3], [Rgb888; 3])>);
+
+fn scene() -> impl Strategy<Value = Scene> {
+    let v = || {
+        (-1.6f32..1.6, -1.6f32..1.6, -1.4f32..1.4, 0.2f32..4.0)
+            .prop_map(|(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w))
+    };
+    let tri = ((v(), v(), v()).prop_map(|(a, b, c)| [a, b, c]), colors());
+    (1u32..=40, 1u32..=40, prop::collection::vec(tri, 1..8))
+}
+
+struct Images {
+    color: Vec<Rgb888>,
+    z32: Vec<u32>,
+    color16: Vec<Rgb888>,
+    z16: Vec<u16>,
+    ids: Vec<u32>,
+    written: [u64; 3],
+}
+
+/// Renders the frame through the strips `cuts` (row boundaries, sorted,
+/// 0 and height included), each into fresh buffers.
+fn render_strips<const S: u32>(frame: &Frame<'_, S>, cuts: &[u32]) -> Images {
+    let w = frame.config().width as usize;
+    let mut im = Images {
+        color: vec![],
+        z32: vec![],
+        color16: vec![],
+        z16: vec![],
+        ids: vec![],
+        written: [0; 3],
+    };
+    for pair in cuts.windows(2) {
+        let (y0, y1) = (pair[0], pair[1]);
+        let n = w * (y1 - y0) as usize;
+        let mut c = vec![Rgb888::new(1, 2, 3); n];
+        let mut z = vec![u32::MAX; n];
+        im.written[0] += frame
+            .render_rows(y0, y1, &mut c[..], &mut z[..])
+            .unwrap()
+            .pixels_written;
+        im.color.extend(c);
+        im.z32.extend(z);
+        let mut c = vec![Rgb888::new(1, 2, 3); n];
+        let mut z = vec![u16::MAX; n];
+        im.written[1] += frame
+            .render_rows(y0, y1, &mut c[..], &mut z[..])
+            .unwrap()
+            .pixels_written;
+        im.color16.extend(c);
+        im.z16.extend(z);
+        let mut ids = vec![TriangleId(0); n];
+        im.written[2] += frame
+            .render_rows(y0, y1, &mut ids[..], &mut NoDepth)
+            .unwrap()
+            .pixels_written;
+        im.ids.extend(ids.into_iter().map(|t| t.0));
+    }
+    im
+}
+
+fn check_strips<const S: u32>(
+    w: u32,
+    h: u32,
+    tris: &[([Vec4; 3], [Rgb888; 3])],
+    func: DepthFunc,
+    cuts: &[u32],
+) -> Result<(), TestCaseError> {
+    let mut cfg = config_nocull(w, h);
+    cfg.depth_func = func;
+    let mut st = storage(tris.len());
+    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    for (i, (p, c)) in tris.iter().enumerate() {
+        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+    }
+    let whole = render_strips(&frame, &[0, h]);
+    let mut all = vec![0];
+    all.extend(cuts.iter().copied().filter(|&c| c > 0 && c < h));
+    all.push(h);
+    all.sort_unstable();
+    all.dedup();
+    let split = render_strips(&frame, &all);
+    prop_assert!(
+        whole.color == split.color,
+        "Rgb888 colour differs for cuts {:?}",
+        all
+    );
+    prop_assert!(
+        whole.z32 == split.z32,
+        "u32 depth differs for cuts {:?}",
+        all
+    );
+    prop_assert!(
+        whole.color16 == split.color16,
+        "colour (u16 depth) differs for cuts {:?}",
+        all
+    );
+    prop_assert!(
+        whole.z16 == split.z16,
+        "u16 depth differs for cuts {:?}",
+        all
+    );
+    prop_assert!(whole.ids == split.ids, "ids differ for cuts {:?}", all);
+    prop_assert_eq!(whole.written, split.written);
+    // One-row strips as well: the finest split.
+    let rows: Vec<u32> = (0..=h).collect();
+    let fine = render_strips(&frame, &rows);
+    prop_assert!(
+        whole.color == fine.color
+            && whole.z32 == fine.z32
+            && whole.z16 == fine.z16
+            && whole.ids == fine.ids
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(cases(512))]
+
+    /// Any split into strips gives the identical frame, bit for bit: Gouraud
+    /// Rgb888 colour with u32 and with u16 depth, and triangle ids.
+    #[test]
+    fn strip_split_gives_identical_frame(
+        (w, h, tris) in scene(),
+        cuts in prop::collection::vec(0u32..40, 0..6),
+        less_equal in any::<bool>(),
+        s4 in any::<bool>(),
+    ) {
+        let func = if less_equal { DepthFunc::LessEqual } else { DepthFunc::Less };
+        if s4 {
+            check_strips::<4>(w, h, &tris, func, &cuts)?;
+        } else {
+            check_strips::<8>(w, h, &tris, func, &cuts)?;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Closed fans (piglit triangle-rasterization-overdraw)
+// ---------------------------------------------------------------------------
+
+/// Builds a fan around window point `c` (px): rim at radius `r` (+ noise)
+/// with tangential steps in `[0, step)` px, every vertex scaled by a
+/// random w when `projected`. Rim vertices are kept only if they turn
+/// strictly counter-clockwise (window space) from the previous one after
+/// snapping, so the fan is star-shaped and closed.
+fn build_fan<const S: u32>(
+    w: u32,
+    h: u32,
+    c: (f64, f64),
+    r: f64,
+    step: f64,
+    projected: bool,
+    rng: &mut SplitMix,
+) -> (Vec<[microraster::Vec4; 3]>, Vec<SubPt>, SubPt) {
+    let wgen = |rng: &mut SplitMix| if projected { rng.range(0.25, 4.0) } else { 1.0 };
+    let snap1 = |v: Vec4| {
+        let s = microraster::fixed::snap::<S>(v.x, v.y, v.z, v.w, w, h).unwrap();
+        (s.x as i64, s.y as i64)
+    };
+    let cv = wvzw(c.0, c.1, 0.0, wgen(rng), w, h);
+    let cs = snap1(cv);
+    let theta0 = rng.range(0.0, std::f64::consts::TAU);
+    let mut theta = theta0;
+    let mut rim: Vec<(Vec4, SubPt)> = Vec::new();
+    while theta < theta0 + std::f64::consts::TAU {
+        let rr = r + rng.range(-0.5, 0.5);
+        let p = (c.0 + rr * theta.cos(), c.1 + rr * theta.sin());
+        let v = wvzw(p.0, p.1, 0.0, wgen(rng), w, h);
+        let s = snap1(v);
+        let ok = match rim.last() {
+            None => true,
+            Some(&(_, last)) => orient(cs, last, s) > 0,
+        };
+        if ok {
+            rim.push((v, s));
+        }
+        theta += rng.range(0.0, step) / r;
+    }
+    while rim.len() > 3 && orient(cs, rim[rim.len() - 1].1, rim[0].1) <= 0 {
+        rim.pop();
+    }
+    let n = rim.len();
+    let tris = (0..n).map(|k| [cv, rim[k].0, rim[(k + 1) % n].0]).collect();
+    (tris, rim.iter().map(|r| r.1).collect(), cs)
+}
+
+fn check_fan<const S: u32>(
+    w: u32,
+    h: u32,
+    c: (f64, f64),
+    r: f64,
+    step: f64,
+    projected: bool,
+    seed: u64,
+) -> Result<(), TestCaseError> {
+    let mut rng = SplitMix(seed);
+    let (tris, rim, cs) = build_fan::<S>(w, h, c, r, step, projected, &mut rng);
+    prop_assume!(rim.len() >= 3);
+    // The fan is closed: the rim turns once around the centre.
+    let (wn_c, on) = winding(&rim, cs);
+    prop_assert!(!on && wn_c == 1, "fan centre not inside its rim");
+    let cfg = config_nocull(w, h);
+    let counts = hit_counts::<S>(cfg, &tris);
+    let (mut double, mut holes, mut strays) = (vec![], vec![], vec![]);
+    for j in 0..h as i64 {
+        for i in 0..w as i64 {
+            let n = counts[(j * w as i64 + i) as usize];
+            let (wn, on_rim) = winding(&rim, (centre(i, S), centre(j, S)));
+            if n > 1 {
+                double.push((i, j));
+            } else if !on_rim && wn == 1 && n != 1 {
+                holes.push((i, j));
+            } else if !on_rim && wn == 0 && n != 0 {
+                strays.push((i, j));
+            }
+        }
+    }
+    prop_assert!(
+        double.is_empty() && holes.is_empty() && strays.is_empty(),
+        "S={} {} triangles: double hits {:?}, holes {:?}, strays {:?}",
+        S,
+        tris.len(),
+        double,
+        holes,
+        strays
+    );
+    // The whole fan in one frame writes exactly the summed hits.
+    let written = with_frame::<S, _>(cfg, &tris, |f| {
+        let mut ids = vec![TriangleId(0); (w * h) as usize];
+        f.render_rows(0, h, &mut ids[..], &mut NoDepth)
+            .unwrap()
+            .pixels_written
+    });
+    prop_assert_eq!(written, counts.iter().map(|&n| n as u64).sum::<u64>());
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(cases(512))]
+
+    /// A fan with its centre in the frame: every pixel whose centre is
+    /// strictly inside the rim polygon is hit exactly once, pixels outside
+    /// never, and no pixel twice (centres on the rim may go either way).
+    #[test]
+    fn closed_fan_covers_inside_exactly_once(
+        cx in 16.0f64..48.0,
+        cy in 16.0f64..48.0,
+        r in 3.0f64..16.0,
+        projected in any::<bool>(),
+        s4 in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        if s4 {
+            check_fan::<4>(64, 64, (cx, cy), r, 1.0, projected, seed)?;
+        } else {
+            check_fan::<8>(64, 64, (cx, cy), r, 1.0, projected, seed)?;
+        }
+    }
+
+    /// piglit's `-clip` mode: the centre anywhere in [-0.5, 1.5] x the
+    /// frame and the rim outside the frame, so every triangle is cut by the
+    /// frame edges: every pixel of the frame is hit exactly once.
+    #[test]
+    fn closed_fan_around_the_frame_covers_every_pixel_once(
+        cx in -16.0f64..48.0,
+        cy in -16.0f64..48.0,
+        s4 in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        let far = [(0.0, 0.0), (32.0, 0.0), (0.0, 32.0), (32.0, 32.0)]
+            .iter()
+            .map(|&(x, y): &(f64, f64)| (x - cx).hypot(y - cy))
+            .fold(0.0, f64::max);
+        let r = far + 5.0;
+        if s4 {
+            check_fan::<4>(32, 32, (cx, cy), r, 2.0, false, seed)?;
+        } else {
+            check_fan::<8>(32, 32, (cx, cy), r, 2.0, false, seed)?;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Translation invariance
+// ---------------------------------------------------------------------------
+
+type Shot = (Vec<Rgb888>, Vec<u32>, Vec<u32>);
+
+fn shoot<const S: u32>(w: u32, h: u32, tris: &[([Vec4; 3], [Rgb888; 3])]) -> Shot {
+    let mut cfg = config_nocull(w, h);
+    cfg.depth_func = DepthFunc::LessEqual;
+    let mut st = storage(tris.len());
+    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    for (i, (p, c)) in tris.iter().enumerate() {
+        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+    }
+    let n = (w * h) as usize;
+    let mut color = vec![Rgb888::new(0, 0, 0); n];
+    let mut z = vec![u32::MAX; n];
+    frame.render_rows(0, h, &mut color[..], &mut z[..]).unwrap();
+    (color, z, frame_ids(&frame))
+}
+
+proptest! {
+    #![proptest_config(cases(512))]
+
+    /// A scene built in window space with w = 1 (exact), moved by whole
+    /// pixels (dx, dy), renders the same colour, depth and id images moved
+    /// by (dx, dy); every other pixel stays background.
+    #[test]
+    fn moving_scene_by_whole_pixels_moves_images(
+        tris in prop::collection::vec(
+            (prop::array::uniform3((8i64 * 256..=56 * 256, 8i64 * 256..=56 * 256, -1.0f64..=1.0)), colors()),
+            1..6,
+        ),
+        dx in -8i64..=8,
+        dy in -8i64..=8,
+        s4 in any::<bool>(),
+    ) {
+        let (w, h) = (64u32, 64u32);
+        let build = |ox: i64, oy: i64| -> Vec<([Vec4; 3], [Rgb888; 3])> {
+            tris.iter()
+                .map(|(vs, c)| {
+                    let p = vs.map(|(x, y, z)| {
+                        let (cx, cy) = win_to_clip((x + ox * 256) as f64 / 256.0, (y + oy * 256) as f64 / 256.0, w, h);
+                        Vec4::new(cx, cy, z as f32, 1.0)
+                    });
+                    (p, *c)
+                })
+                .collect()
+        };
+        let (a, b) = if s4 {
+            (shoot::<4>(w, h, &build(0, 0)), shoot::<4>(w, h, &build(dx, dy)))
+        } else {
+            (shoot::<8>(w, h, &build(0, 0)), shoot::<8>(w, h, &build(dx, dy)))
+        };
+        for j in 0..h as i64 {
+            for i in 0..w as i64 {
+                let k = (j * w as i64 + i) as usize;
+                let (si, sj) = (i - dx, j - dy);
+                let src = (si >= 0 && sj >= 0 && si < w as i64 && sj < h as i64)
+                    .then(|| (sj * w as i64 + si) as usize);
+                let (ec, ez, eid) = match src {
+                    Some(s) => (a.0[s], a.1[s], a.2[s]),
+                    None => (Rgb888::new(0, 0, 0), u32::MAX, 0),
+                };
+                prop_assert_eq!(b.0[k], ec, "colour at ({}, {})", i, j);
+                prop_assert_eq!(b.1[k], ez, "depth at ({}, {})", i, j);
+                prop_assert_eq!(b.2[k], eid, "id at ({}, {})", i, j);
+            }
+        }
+        // Nothing of the original image fell off the frame.
+        let drawn = |s: &Shot| s.2.iter().filter(|&&v| v != 0).count();
+        prop_assert_eq!(drawn(&a), drawn(&b));
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Stats accounting
+// ---------------------------------------------------------------------------
+
+fn component() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        8 => -1.5f32..1.5,
+        2 => -40.0f32..40.0,
+        1 => -1.0e6f32..1.0e6,
+        1 => prop_oneof![
+            Just(f32::NAN),
+            Just(f32::INFINITY),
+            Just(f32::NEG_INFINITY),
+            Just(f32::MAX),
+            Just(-f32::MAX),
+            Just(1.0e30),
+            Just(0.0),
+        ],
+    ]
+}
+
+fn any_vertex() -> impl Strategy<Value = Vec4> {
+    let w = prop_oneof![6 => 0.2f32..4.0, 1 => -2.0f32..0.0, 1 => Just(0.0f32), 1 => component()];
+    (
+        component(),
+        component(),
+        prop_oneof![3 => -0.9f32..0.9, 1 => component()],
+        w,
+    )
+        .prop_map(|(x, y, z, w)| {
+            Vec4::new(
+                x * w.abs().max(1e-3),
+                y * w.abs().max(1e-3),
+                z * w.abs().max(1e-3),
+                w,
+            )
+        })
+}
+
+fn any_triangle() -> impl Strategy<Value = [Vec4; 3]> {
+    let general = (any_vertex(), any_vertex(), any_vertex()).prop_map(|(a, b, c)| [a, b, c]);
+    let degenerate = (any_vertex(), any_vertex(), -2.0f32..2.0).prop_map(|(a, b, t)| {
+        let c = Vec4::new(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z, 1.0);
+        [a, b, if t > 1.5 { a } else { c }]
+    });
+    let tiny = (-1.0f32..1.0, -1.0f32..1.0).prop_map(|(x, y)| {
+        let d = 1.0e-3;
+        [
+            Vec4::new(x, y, 0.0, 1.0),
+            Vec4::new(x + d, y, 0.0, 1.0),
+            Vec4::new(x, y + d, 0.0, 1.0),
+        ]
+    });
+    prop_oneof![6 => general, 1 => degenerate, 1 => tiny]
+}
+
+fn dropped(s: &Stats) -> u32 {
+    s.culled_object
+        + s.culled_frustum
+        + s.culled_backface
+        + s.culled_degenerate
+        + s.rejected_nonfinite
+        + s.rejected_index
+}
+
+fn check_stats<const S: u32>(cfg: Config, tris: &[[Vec4; 3]]) -> Result<(), TestCaseError> {
+    let mut st = storage(tris.len());
+    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    let mut kept = 0u32;
+    for (i, t) in tris.iter().enumerate() {
+        let before = frame.stats();
+        let len = frame.triangles().len();
+        frame
+            .push_clip_triangle(*t, [Rgb888::new(9, 9, 9); 3], i as u32)
+            .unwrap();
+        let after = frame.stats();
+        let d_stored = after.stored - before.stored;
+        let d_dropped = dropped(&after) - dropped(&before);
+        let d_clipped = after.clipped - before.clipped;
+        let pieces = frame.triangles().len() - len;
+        prop_assert_eq!(after.submitted - before.submitted, 1);
+        prop_assert_eq!(pieces as u32, d_stored, "stored counts the pieces");
+        prop_assert!(
+            (d_dropped == 1 && d_stored == 0) || (d_dropped == 0 && d_stored >= 1),
+            "{:?}: counted {} times, stored {}: {:?} -> {:?}",
+            t,
+            d_dropped,
+            d_stored,
+            before,
+            after
+        );
+        prop_assert!(d_clipped <= 1);
+        prop_assert!(
+            d_stored <= 1 || d_clipped == 1,
+            "several pieces without clipping"
+        );
+        prop_assert!(frame.triangles()[len..].iter().all(|s| s.id() == i as u32));
+        let non_finite = t
+            .iter()
+            .any(|v| !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite() && v.w.is_finite()));
+        if non_finite {
+            prop_assert_eq!(after.rejected_nonfinite - before.rejected_nonfinite, 1);
+        }
+        kept += (d_stored > 0) as u32;
+    }
+    let s = frame.stats();
+    prop_assert_eq!(s.submitted, tris.len() as u32);
+    prop_assert_eq!(s.submitted, dropped(&s) + kept);
+    prop_assert_eq!(s.stored as usize, frame.triangles().len());
+    // And whatever was stored renders without panicking, in strips too.
+    let _ = frame_ids(&frame);
+    let _ = frame_ids_strips(&frame, 3);
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(cases(1024))]
+
+    /// Every submitted triangle is stored (as one or more pieces) or counted
+    /// in exactly one culled/rejected counter, whatever its coordinates
+    /// (NaN, infinities, w <= 0, huge, degenerate, off-screen, culled).
+    #[test]
+    fn stats_account_for_every_triangle(
+        tris in prop::collection::vec(any_triangle(), 1..24),
+        cull in prop_oneof![Just(CullMode::Back), Just(CullMode::Front), Just(CullMode::None)],
+        front in prop_oneof![Just(FrontFace::Ccw), Just(FrontFace::Cw)],
+        (w, h) in (1u32..=64, 1u32..=64),
+        s4 in any::<bool>(),
+    ) {
+        let mut cfg = Config::new(w, h);
+        cfg.cull = cull;
+        cfg.front_face = front;
+        if s4 { check_stats::<4>(cfg, &tris)?; } else { check_stats::<8>(cfg, &tris)?; }
+    }
+
+    /// Triangles inside the near, far and guard-band planes are never
+    /// clipped: each is stored as exactly one piece or counted once.
+    #[test]
+    fn unclipped_triangles_store_at_most_one_piece((w, h, pos) in clip_case::<8>()) {
+        let (gx, gy) = guard_band_ndc::<8>(w, h);
+        prop_assume!(pos.iter().all(|p| outcode(*p, gx, gy) & outcode::CLIP == 0));
+        let mut st = storage(1);
+        let mut frame = Frame::<8>::new(config_nocull(w, h), &mut st).unwrap();
+        frame.push_clip_triangle(pos, [Rgb888::new(0, 0, 0); 3], 0).unwrap();
+        let s = frame.stats();
+        prop_assert_eq!(s.clipped, 0);
+        prop_assert_eq!(s.stored + dropped(&s), 1);
+    }
+
+    /// Colour non-finite (only reachable through `push_triangle`) is
+    /// rejected and counted.
+    #[test]
+    fn non_finite_colour_is_rejected(k in 0usize..3, ch in 0usize..3, bad in prop_oneof![Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY)]) {
+        let mut st = storage(1);
+        let mut frame = Frame::<8>::new(config_nocull(8, 8), &mut st).unwrap();
+        let mut tri = [
+            ClipVertex { pos: Vec4::new(-1.0, -1.0, 0.0, 1.0), color: [1.0; 3] },
+            ClipVertex { pos: Vec4::new(1.0, -1.0, 0.0, 1.0), color: [1.0; 3] },
+            ClipVertex { pos: Vec4::new(0.0, 1.0, 0.0, 1.0), color: [1.0; 3] },
+        ];
+        tri[k].color[ch] = bad;
+        frame.push_triangle(tri, 0).unwrap();
+        prop_assert_eq!(frame.stats().rejected_nonfinite, 1);
+        prop_assert_eq!(frame.triangles().len(), 0);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Other paths to the same pixels: bins, immediate strips, cached meshes
+// ---------------------------------------------------------------------------
+
+/// Whole-frame colour (Gouraud, u32 depth) and id images of a frame.
+fn whole_frame<const S: u32>(frame: &Frame<'_, S>) -> (Vec<Rgb888>, Vec<u32>, Vec<u32>) {
+    let Config { width, height, .. } = *frame.config();
+    let n = (width * height) as usize;
+    let mut c = vec![Rgb888::new(1, 2, 3); n];
+    let mut z = vec![u32::MAX; n];
+    frame
+        .render_rows(0, height, &mut c[..], &mut z[..])
+        .unwrap();
+    (c, z, frame_ids(frame))
+}
+
+proptest! {
+    #![proptest_config(cases(512))]
+
+    /// `Frame::bin` + `render_strip` over every strip gives exactly the
+    /// pixels of `render_rows` over the whole frame, for any strip height.
+    #[test]
+    fn binned_strips_equal_render_rows(
+        (w, h, tris) in scene(),
+        strip_rows in 1u32..48,
+    ) {
+        let mut st = storage(tris.len());
+        let mut frame: Frame = Frame::new(config_nocull(w, h), &mut st).unwrap();
+        for (i, (p, c)) in tris.iter().enumerate() {
+            frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+        }
+        let (wc, wz, wid) = whole_frame(&frame);
+        let strips = h.div_ceil(strip_rows) as usize;
+        let mut offsets = vec![0u32; strips + 1];
+        let mut items = vec![0u32; frame.bin_entries(strip_rows)];
+        let bins = frame.bin(strip_rows, &mut offsets, &mut items).unwrap();
+        prop_assert_eq!(bins.strips() as usize, strips);
+        let (mut c, mut z, mut ids) = (vec![], vec![], vec![]);
+        for s in 0..bins.strips() {
+            let (y0, y1) = bins.rows(s, h);
+            let n = (w * (y1 - y0)) as usize;
+            let mut sc = vec![Rgb888::new(1, 2, 3); n];
+            let mut sz = vec![u32::MAX; n];
+            frame.render_strip(&bins, s, &mut sc[..], &mut sz[..]).unwrap();
+            let mut si = vec![TriangleId(0); n];
+            frame.render_strip(&bins, s, &mut si[..], &mut NoDepth).unwrap();
+            c.extend(sc);
+            z.extend(sz);
+            ids.extend(si.into_iter().map(|t| t.0));
+        }
+        prop_assert!(c == wc && z == wz && ids == wid, "binned strips of {} rows differ", strip_rows);
+    }
+
+    /// `StripRenderer` (no setup storage) draws, strip by strip, exactly the
+    /// pixels `Frame::render_rows` draws for those rows, with the same
+    /// counters.
+    #[test]
+    fn strip_renderer_equals_frame(
+        (w, h, tris) in scene(),
+        cuts in prop::collection::vec(1u32..40, 0..5),
+        s4 in any::<bool>(),
+    ) {
+        if s4 {
+            check_strip_renderer::<4>(w, h, &tris, &cuts)?;
+        } else {
+            check_strip_renderer::<8>(w, h, &tris, &cuts)?;
+        }
+    }
+
+    /// `draw_mesh_cached` (vertices transformed and snapped once) stores
+    /// the same triangles, counts the same statistics and renders the same
+    /// pixels as `draw_mesh`, and `StripRenderer::draw_mesh` the same
+    /// pixels again; for meshes with off-screen, clipped, behind-the-eye and
+    /// non-finite vertices, bad indices and colour lists of any length.
+    #[test]
+    fn draw_mesh_cached_equals_draw_mesh(
+        positions in prop::collection::vec(
+            prop_oneof![
+                10 => (-3.0f32..3.0, -3.0f32..3.0, -3.0f32..3.0).prop_map(|(x, y, z)| Vec3::new(x, y, z)),
+                1 => Just(Vec3::new(f32::NAN, 0.0, 0.0)),
+                1 => (-1.0e6f32..1.0e6, -1.0e6f32..1.0e6).prop_map(|(x, y)| Vec3::new(x, y, 0.0)),
+            ],
+            3..12,
+        ),
+        raw_indices in prop::collection::vec((0u32..13, 0u32..13, 0u32..13), 1..16),
+        color_kind in 0u8..3,
+        ncolors in 0usize..16,
+        angle in 0.0f32..6.3,
+        dist in 0.5f32..8.0,
+        cull in prop_oneof![Just(CullMode::Back), Just(CullMode::Front), Just(CullMode::None)],
+        (w, h) in (1u32..=40, 1u32..=40),
+    ) {
+        let indices: Vec<[u32; 3]> = raw_indices.iter().map(|&(a, b, c)| [a, b, c]).collect();
+        let palette: Vec<Rgb888> = (0..ncolors as u8).map(|i| Rgb888::new(i.wrapping_mul(40), 255u8.wrapping_sub(i.wrapping_mul(13)), i.wrapping_mul(7))).collect();
+        let colors = match color_kind {
+            0 => MeshColors::Uniform(Rgb888::new(10, 200, 30)),
+            1 => MeshColors::PerTriangle(&palette),
+            _ => MeshColors::PerVertex(&palette),
+        };
+        let mesh = Mesh { positions: &positions, indices: &indices, colors, bounds: None };
+        let mvp = Mat4::perspective(1.0, w as f32 / h as f32, 0.5, 20.0)
+            * Mat4::translation(Vec3::new(0.0, 0.0, -dist))
+            * Mat4::rotation_y(angle)
+            * Mat4::rotation_x(angle * 0.7);
+        let mut cfg = Config::new(w, h);
+        cfg.cull = cull;
+        let mut st1 = storage(indices.len());
+        let mut st2 = storage(indices.len());
+        let mut a: Frame = Frame::new(cfg, &mut st1).unwrap();
+        let mut b: Frame = Frame::new(cfg, &mut st2).unwrap();
+        a.draw_mesh(&mesh, &mvp, 5).unwrap();
+        let mut cache = vec![ProcessedVertex::EMPTY; positions.len()];
+        b.draw_mesh_cached(&mesh, &mvp, 5, &mut cache).unwrap();
+        // (With a colour list too short for the mesh the two paths count
+        // some triangles under different reasons: see the ignored
+        // `draw_mesh_cached_counts_missing_colours_like_draw_mesh`.)
+        let colours_complete = match colors {
+            MeshColors::Uniform(_) => true,
+            MeshColors::PerTriangle(c) => c.len() >= indices.len(),
+            MeshColors::PerVertex(c) => c.len() >= positions.len(),
+        };
+        if colours_complete {
+            prop_assert_eq!(a.stats(), b.stats());
+        } else {
+            prop_assert_eq!(a.stats().submitted, b.stats().submitted);
+            prop_assert_eq!(a.stats().stored, b.stats().stored);
+        }
+        prop_assert_eq!(a.triangles(), b.triangles());
+        let wa = whole_frame(&a);
+        prop_assert!(wa == whole_frame(&b), "images differ");
+        // Immediate mode, one strip for the whole frame.
+        let n = (w * h) as usize;
+        let mut c = vec![Rgb888::new(1, 2, 3); n];
+        let mut z = vec![u32::MAX; n];
+        let mut r: StripRenderer<'_, Rgb888, [u32]> = StripRenderer::new(cfg, 0, h, &mut c[..], &mut z[..]).unwrap();
+        r.draw_mesh(&mesh, &mvp, 5);
+        prop_assert_eq!(r.stats(), a.stats());
+        prop_assert!(c == wa.0 && z == wa.1, "immediate mode differs");
+        // A cache shorter than the mesh is refused.
+        if !positions.is_empty() {
+            let mut short = vec![ProcessedVertex::EMPTY; positions.len() - 1];
+            prop_assert_eq!(
+                b.draw_mesh_cached(&mesh, &mvp, 5, &mut short),
+                Err(Error::VertexCacheSize { expected: positions.len(), actual: positions.len() - 1 })
+            );
+        }
+    }
+}
+
+fn check_strip_renderer<const S: u32>(
+    w: u32,
+    h: u32,
+    tris: &[([Vec4; 3], [Rgb888; 3])],
+    cuts: &[u32],
+) -> Result<(), TestCaseError> {
+    let cfg = config_nocull(w, h);
+    let mut st = storage(tris.len());
+    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    for (i, (p, c)) in tris.iter().enumerate() {
+        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+    }
+    let mut all = vec![0];
+    all.extend(cuts.iter().copied().filter(|&c| c < h));
+    all.push(h);
+    all.sort_unstable();
+    all.dedup();
+    for pair in all.windows(2) {
+        let (y0, y1) = (pair[0], pair[1]);
+        let n = (w * (y1 - y0)) as usize;
+        let mut fc = vec![Rgb888::new(1, 2, 3); n];
+        let mut fz = vec![0xFFFFu16; n];
+        let fw = frame.render_rows(y0, y1, &mut fc[..], &mut fz[..]).unwrap();
+        let mut c = vec![Rgb888::new(1, 2, 3); n];
+        let mut z = vec![0xFFFFu16; n];
+        let mut r: StripRenderer<'_, Rgb888, [u16], S> =
+            StripRenderer::new(cfg, y0, y1, &mut c[..], &mut z[..]).unwrap();
+        for (i, (p, col)) in tris.iter().enumerate() {
+            r.push_clip_triangle(*p, *col, i as u32);
+        }
+        prop_assert_eq!(r.stats(), frame.stats());
+        prop_assert_eq!(r.render_stats(), fw);
+        prop_assert!(c == fc && z == fz, "rows {}..{} differ", y0, y1);
+    }
+    Ok(())
+}
+
+/// `draw_mesh_cached` promises the result of `draw_mesh`; with a colour
+/// list too short for the mesh, a triangle that is also off-screen is
+/// counted as `rejected_index` by `draw_mesh` but as `culled_frustum` by
+/// `draw_mesh_cached` (which tests the frustum before looking the colour
+/// up). Images are identical; only `Stats` differ.
+#[test]
+#[ignore = "BUG: draw_mesh_cached counts a triangle with a missing colour (PerTriangle/PerVertex list too short) under culled_frustum / culled_backface / culled_degenerate / rejected_nonfinite when it also fails that test, where draw_mesh counts rejected_index: Stats differ"]
+fn draw_mesh_cached_counts_missing_colours_like_draw_mesh() {
+    let positions = [
+        Vec3::new(10.0, 0.0, 0.0),
+        Vec3::new(11.0, 0.0, 0.0),
+        Vec3::new(10.0, 1.0, 0.0),
+    ];
+    let indices = [[0, 1, 2]];
+    let mesh = Mesh {
+        positions: &positions,
+        indices: &indices,
+        colors: MeshColors::PerTriangle(&[]),
+        bounds: None,
+    };
+    let (mut s1, mut s2) = (storage(1), storage(1));
+    let mut a: Frame = Frame::new(Config::new(8, 8), &mut s1).unwrap();
+    let mut b: Frame = Frame::new(Config::new(8, 8), &mut s2).unwrap();
+    a.draw_mesh(&mesh, &Mat4::IDENTITY, 0).unwrap();
+    let mut cache = [ProcessedVertex::EMPTY; 3];
+    b.draw_mesh_cached(&mesh, &Mat4::IDENTITY, 0, &mut cache)
+        .unwrap();
+    assert_eq!(a.stats().rejected_index, 1);
+    assert_eq!(b.stats(), a.stats());
+}
