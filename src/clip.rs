@@ -14,6 +14,11 @@
 //!   `w > 0` (inside near and guard planes implies `w >= 0`; `w == 0` is
 //!   rejected at snapping).
 //!
+//! Clip distances and intersections are computed in `f64` (a difference of
+//! two finite `f32` values, or `g * w`, cannot overflow there) and each new
+//! vertex is then put exactly on its plane, so even extreme `w` ratios give
+//! a vertex inside the guard band.
+//!
 //! Watertightness: an edge shared by two triangles is clipped in the same
 //! direction in both (always from the inside vertex towards the outside
 //! one), so both get bit-identical new vertices. The polygon has at most
@@ -30,21 +35,6 @@ pub struct ClipVertex {
     pub pos: Vec4,
     /// Red, green, blue in `0.0..=255.0`.
     pub color: [f32; 3],
-}
-
-impl ClipVertex {
-    fn lerp(&self, o: &ClipVertex, t: f32) -> ClipVertex {
-        let c = &self.color;
-        let d = &o.color;
-        ClipVertex {
-            pos: self.pos.lerp(o.pos, t),
-            color: [
-                c[0] + (d[0] - c[0]) * t,
-                c[1] + (d[1] - c[1]) * t,
-                c[2] + (d[2] - c[2]) * t,
-            ],
-        }
-    }
 }
 
 /// Outcode bits.
@@ -118,17 +108,62 @@ pub fn outcode(p: Vec4, gx: f32, gy: f32) -> u16 {
 /// The clipped polygon: at most 9 vertices.
 pub type Polygon = Vec<ClipVertex, 9>;
 
-/// Signed distance to the plane `bit` (inside where `>= 0`).
+/// Signed distance to the plane `bit` (inside where `>= 0`), in `f64` so
+/// that neither `g * w` nor a difference of two finite `f32` values can
+/// overflow.
 #[inline]
-fn distance(bit: u16, p: Vec4, gx: f32, gy: f32) -> f32 {
+fn distance(bit: u16, p: Vec4, gx: f64, gy: f64) -> f64 {
     use outcode::*;
+    let (x, y, z, w) = (p.x as f64, p.y as f64, p.z as f64, p.w as f64);
     match bit {
-        NEAR => p.z + p.w,
-        FAR => p.w - p.z,
-        GUARD_LEFT => p.x + gx * p.w,
-        GUARD_RIGHT => gx * p.w - p.x,
-        GUARD_BOTTOM => p.y + gy * p.w,
-        _ => gy * p.w - p.y, // GUARD_TOP
+        NEAR => z + w,
+        FAR => w - z,
+        GUARD_LEFT => x + gx * w,
+        GUARD_RIGHT => gx * w - x,
+        GUARD_BOTTOM => y + gy * w,
+        _ => gy * w - y, // GUARD_TOP
+    }
+}
+
+/// The point where the edge from `vi` (inside, distance `di`) to `vo`
+/// (outside, `dout`) crosses plane `bit`, interpolated in `f64` and then put
+/// exactly on the plane (so a `t` that rounds to 1 for extreme `w` ratios
+/// still yields a point inside the guard band).
+fn intersect(
+    bit: u16,
+    vi: &ClipVertex,
+    vo: &ClipVertex,
+    di: f64,
+    dout: f64,
+    gx: f64,
+    gy: f64,
+) -> ClipVertex {
+    use outcode::*;
+    // Weights of the outside and inside vertex, each computed directly (not
+    // one as 1 minus the other), so a vertex with a huge `w` keeps its tiny
+    // but decisive share.
+    let den = di - dout;
+    let t = di / den;
+    let u = -dout / den;
+    let l = |a: f32, b: f32| a as f64 * u + b as f64 * t;
+    let (mut x, mut y, mut z) = (
+        l(vi.pos.x, vo.pos.x),
+        l(vi.pos.y, vo.pos.y),
+        l(vi.pos.z, vo.pos.z),
+    );
+    let w = l(vi.pos.w, vo.pos.w);
+    match bit {
+        NEAR => z = -w,
+        FAR => z = w,
+        GUARD_LEFT => x = -gx * w,
+        GUARD_RIGHT => x = gx * w,
+        GUARD_BOTTOM => y = -gy * w,
+        _ => y = gy * w,
+    }
+    let c = |k: usize| l(vi.color[k], vo.color[k]) as f32;
+    ClipVertex {
+        pos: Vec4::new(x as f32, y as f32, z as f32, w as f32),
+        color: [c(0), c(1), c(2)],
     }
 }
 
@@ -136,6 +171,7 @@ fn distance(bit: u16, p: Vec4, gx: f32, gy: f32) -> f32 {
 /// [`outcode::CLIP`]). Returns the convex polygon, possibly empty.
 pub fn clip_triangle(tri: &[ClipVertex; 3], mask: u16, gx: f32, gy: f32) -> Polygon {
     use outcode::*;
+    let (gx, gy) = (gx as f64, gy as f64);
     let mut poly = Polygon::new();
     for v in tri {
         // Capacity 9 >= 3: cannot fail.
@@ -161,9 +197,12 @@ pub fn clip_triangle(tri: &[ClipVertex; 3], mask: u16, gx: f32, gy: f32) -> Poly
                 // Always interpolate from the inside vertex to the outside
                 // one, so a shared edge gives the same point in both
                 // triangles.
-                let (vi, vo, di, dout) = if a_in { (a, b, da, db) } else { (b, a, db, da) };
-                let t = di / (di - dout);
-                let _ = out.push(vi.lerp(vo, t));
+                let v = if a_in {
+                    intersect(bit, a, b, da, db, gx, gy)
+                } else {
+                    intersect(bit, b, a, db, da, gx, gy)
+                };
+                let _ = out.push(v);
             }
         }
         // A convex polygon cut by one plane gains at most one vertex, so

@@ -72,18 +72,24 @@ pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
 /// Rounds `v` to the nearest integer (halves up) and checks the result is
 /// within `±COORD_LIMIT`. `None` for NaN, infinities and out-of-range values.
 ///
-/// No float function is involved: `t = v + 0.5` is truncated by `as` and
-/// corrected by one where truncation went up (negative `t`), so the result
-/// is `floor(v + 0.5)` on every target and with either float backend.
+/// No float function is involved and no float rounding either: `floor(v)`
+/// comes from truncation (corrected by one for negative non-integers), the
+/// fraction `v - floor(v)` is exact in `f32`, and it decides the rounding.
+/// (`floor(v + 0.5)` would not do: for odd `v` in `[2^23, 2^24)` the sum is
+/// a tie that `f32` rounds to even.)
 #[inline]
 fn round_to_coord(v: f32) -> Option<i32> {
-    let t = v + 0.5;
-    if !(t.is_finite() && t.abs() <= COORD_LIMIT as f32) {
+    if !(v.is_finite() && v.abs() <= COORD_LIMIT as f32) {
         return None;
     }
-    let mut i = t as i32;
-    if (i as f32) > t {
+    // |v| <= 2^28: `as` truncates exactly, and `i as f32` is exact (below
+    // 2^24 every integer is representable; above it `v` is an integer).
+    let mut i = v as i32;
+    if (i as f32) > v {
         i -= 1;
+    }
+    if v - i as f32 >= 0.5 {
+        i += 1;
     }
     Some(i)
 }
@@ -182,6 +188,19 @@ mod tests {
             let edge = (gx + 1.0) * (MAX_DIMENSION as f32 / 2.0) * (1u32 << s) as f32;
             assert!(edge <= GUARD_BAND as f32 * 1.0001, "s={s} edge={edge}");
         }
+    }
+
+    #[test]
+    fn rounding_is_exact_near_2_pow_23() {
+        assert_eq!(round_to_coord(8_388_609.0), Some(8_388_609));
+        assert_eq!(round_to_coord(-8_388_609.0), Some(-8_388_609));
+        assert_eq!(round_to_coord(2.5), Some(3));
+        assert_eq!(round_to_coord(-2.5), Some(-2));
+        assert_eq!(round_to_coord(-2.6), Some(-3));
+        assert_eq!(round_to_coord(0.49999997), Some(0));
+        assert_eq!(round_to_coord(COORD_LIMIT as f32), Some(COORD_LIMIT));
+        assert_eq!(round_to_coord(-(COORD_LIMIT as f32)), Some(-COORD_LIMIT));
+        assert_eq!(round_to_coord(COORD_LIMIT as f32 * 1.01), None);
     }
 
     #[test]

@@ -18,9 +18,10 @@ use crate::clip::{clip_triangle, outcode, ClipVertex};
 use crate::color::Pixel;
 use crate::depth::{DepthBuffer, DepthFunc};
 use crate::fixed::{guard_band_ndc, MAX_DIMENSION};
+use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::raster::{draw, Strip};
-use crate::setup::{setup, setup_geometry, Rejected, SetupTriangle};
+use crate::setup::{setup, setup_geometry, triangulate, Rejected, SetupTriangle};
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
 /// Which faces to cull.
@@ -616,6 +617,16 @@ impl<'s, const S: u32> Frame<'s, S> {
                 continue;
             };
             let v = [a, b, d];
+            // A missing colour counts as a bad index first, as in `draw_mesh`.
+            let colors_ok = match mesh.colors {
+                MeshColors::Uniform(_) => true,
+                MeshColors::PerTriangle(cs) => i < cs.len(),
+                MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
+            };
+            if !colors_ok {
+                stats.rejected_index += 1;
+                continue;
+            }
             let color = |k: usize| -> Option<[f32; 3]> {
                 Some(rgb_f32(match mesh.colors {
                     MeshColors::Uniform(c) => c,
@@ -941,15 +952,30 @@ pub(crate) fn process<const S: u32>(
         stats.culled_frustum += 1;
         return;
     }
-    // Fan from vertex 0; each piece is culled and set up on its own
-    // (all pieces share the winding of the input triangle).
+    // Snap the polygon's vertices once; split it into triangles that all
+    // wind the same way (a fan, unless snapping made the polygon slightly
+    // non-convex, see `setup::triangulate`); cull and set up each piece.
+    let mut snapped: heapless::Vec<Option<SnappedVertex>, 9> = heapless::Vec::new();
+    for v in &poly {
+        let p = v.pos;
+        let _ = snapped.push(snap::<S>(p.x, p.y, p.z, p.w, c.width, c.height));
+    }
     let mut first_reason = None;
-    for i in 1..poly.len() - 1 {
-        let piece = [poly[0], poly[i], poly[i + 1]];
-        match setup::<S>(&piece, c.width, c.height, c.cull, c.front_face, id) {
-            Ok(t) => {
+    for [a, b, d] in triangulate(&snapped) {
+        let (a, b, d) = (a as usize, b as usize, d as usize);
+        let (Some(sa), Some(sb), Some(sd)) = (snapped[a], snapped[b], snapped[d]) else {
+            first_reason.get_or_insert(Rejected::NonFinite);
+            continue;
+        };
+        match setup_geometry::<S>(&[sa, sb, sd], c.width, c.height, c.cull, c.front_face) {
+            Ok(g) => {
+                let (pa, pb, pd) = (&poly[a], &poly[b], &poly[d]);
                 // At most 7 pieces from a 9-gon: cannot fail.
-                let _ = out.push(t);
+                let _ = out.push(g.finish(
+                    [1.0 / pa.pos.w, 1.0 / pb.pos.w, 1.0 / pd.pos.w],
+                    [pa.color, pb.color, pd.color],
+                    id,
+                ));
                 stats.stored += 1;
             }
             Err(r) => {

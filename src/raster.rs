@@ -22,8 +22,8 @@
 //!
 //! Depth is the plane through the three `Z32` vertex depths, evaluated from
 //! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
-//! in `f64` at the start of each run of pixels (a box row for small
-//! triangles, every [`RESYNC`] pixels of a span) and stepped by its `f64`
+//! in `f64` at the start of each run of pixels (a row's first covered pixel
+//! for small triangles, every [`RESYNC`] pixels of a span) and stepped by its `f64`
 //! gradient in between. At a covered pixel each term is at most `2^32`, so
 //! the error is far below one `Z32` LSB (under `2^-10` with the steps) and
 //! the written `Z32` is the floor of the exact plane value, or one off only
@@ -285,15 +285,20 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
         let step = [edges[0].step_x, edges[1].step_x, edges[2].step_x];
         for _ in row_first..=row_last {
             let mut e = [edges[0].row, edges[1].row, edges[2].row];
-            let mut acc = shader.start::<D>(t, e);
+            // Interpolants start at the row's first covered pixel, where
+            // every edge value is non-negative (no cancellation).
+            let mut acc: Option<Acc> = None;
             for n in 0..=max_n as usize {
                 if (e[0] | e[1] | e[2]) >= 0 {
-                    written += shader.pixel(t, strip, base + n, &acc);
+                    let a = acc.get_or_insert_with(|| shader.start::<D>(t, e));
+                    written += shader.pixel(t, strip, base + n, a);
                 }
                 e[0] += step[0];
                 e[1] += step[1];
                 e[2] += step[2];
-                shader.step::<D>(&mut acc);
+                if let Some(a) = acc.as_mut() {
+                    shader.step::<D>(a);
+                }
             }
             for edge in edges.iter_mut() {
                 edge.row += edge.step_y;

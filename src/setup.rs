@@ -287,3 +287,161 @@ impl Geometry {
         }
     }
 }
+
+/// Twice the signed area of `(a, b, c)` in window space, exactly.
+#[inline]
+fn orient(a: SnappedVertex, b: SnappedVertex, c: SnappedVertex) -> i64 {
+    area2([a.x, b.x, c.x], [a.y, b.y, c.y])
+}
+
+/// Splits a clipped polygon into triangles (index triples) that all wind
+/// the same way.
+///
+/// The polygon was convex in clip space, so a fan from vertex 0 almost
+/// always works. Snapping can bend three nearly collinear clip vertices
+/// into a slightly non-convex (even self-overlapping) polygon; a fan piece
+/// across the reflex vertex then winds the other way and would be drawn
+/// over its neighbours (or culled, leaving the overlap). Then, with exact
+/// integer orientation tests, a fan from another apex whose pieces of the
+/// polygon's winding are contiguous is used without the folded slivers at
+/// its ends, or failing that the polygon is ear-clipped. Both keep the
+/// boundary edges (shared with neighbouring triangles) unchanged. Vertices
+/// that could not be snapped (`None`) keep the fan, whose pieces through
+/// them are then rejected.
+pub(crate) fn triangulate(v: &[Option<SnappedVertex>]) -> heapless::Vec<[u8; 3], 7> {
+    let mut out = heapless::Vec::new();
+    let n = v.len().min(9);
+    let fan = |out: &mut heapless::Vec<[u8; 3], 7>| {
+        for i in 1..n.saturating_sub(1) {
+            let _ = out.push([0, i as u8, i as u8 + 1]);
+        }
+    };
+    let mut s = [SnappedVertex::default(); 9];
+    for (k, slot) in s.iter_mut().enumerate().take(n) {
+        match v[k] {
+            Some(p) => *slot = p,
+            None => {
+                fan(&mut out);
+                return out;
+            }
+        }
+    }
+    // Each fan term is below 2^59 in magnitude; seven of them fit in i64.
+    let areas = |i: usize| orient(s[0], s[i], s[i + 1]);
+    let total: i64 = (1..n.saturating_sub(1)).map(areas).sum();
+    let sign = total.signum();
+    if (1..n.saturating_sub(1)).all(|i| areas(i) * sign >= 0) || sign == 0 {
+        fan(&mut out);
+        return out;
+    }
+    // A fan from some apex whose pieces of the polygon's winding form one
+    // contiguous run: those pieces sweep monotonically round the apex, so
+    // they never overlap. The pieces left out (winding the other way, at
+    // the ends of the run) are slivers that snapping folded over; drawing
+    // them would hit pixels twice.
+    for k in 0..n {
+        let piece = |i: usize| [k, (k + i) % n, (k + i + 1) % n];
+        let turn = |i: usize| {
+            let [a, b, c] = piece(i);
+            orient(s[a], s[b], s[c]) * sign
+        };
+        let pos: heapless::Vec<usize, 7> = (1..n - 1).filter(|&i| turn(i) > 0).collect();
+        let (Some(&first), Some(&last)) = (pos.first(), pos.last()) else {
+            continue;
+        };
+        if (first..=last).all(|i| turn(i) >= 0) {
+            for &i in &pos {
+                let [a, b, c] = piece(i);
+                let _ = out.push([a as u8, b as u8, c as u8]);
+            }
+            return out;
+        }
+    }
+    // Otherwise ear clipping on the ring of indices.
+    let mut ring: heapless::Vec<u8, 9> = (0..n as u8).collect();
+    while ring.len() > 3 {
+        let m = ring.len();
+        let mut cut = None;
+        for i in 0..m {
+            let (p, c, q) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
+            let (a, b, d) = (s[p as usize], s[c as usize], s[q as usize]);
+            let turn = orient(a, b, d) * sign;
+            if turn == 0 {
+                // Collinear: dropping the vertex changes no coverage.
+                cut = Some((i, None));
+                break;
+            }
+            if turn < 0 {
+                continue;
+            }
+            // An ear if no other vertex lies inside or on it.
+            let blocked = ring.iter().any(|&r| {
+                let e = s[r as usize];
+                r != p
+                    && r != c
+                    && r != q
+                    && e != a
+                    && e != b
+                    && e != d
+                    && orient(a, b, e) * sign >= 0
+                    && orient(b, d, e) * sign >= 0
+                    && orient(d, a, e) * sign >= 0
+            });
+            if !blocked {
+                cut = Some((i, Some([p, c, q])));
+                break;
+            }
+        }
+        match cut {
+            Some((i, tri)) => {
+                if let Some(t) = tri {
+                    let _ = out.push(t);
+                }
+                ring.remove(i);
+            }
+            None => break,
+        }
+    }
+    if ring.len() >= 3 {
+        for i in 1..ring.len() - 1 {
+            let _ = out.push([ring[0], ring[i], ring[i + 1]]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: i32, y: i32) -> Option<SnappedVertex> {
+        Some(SnappedVertex { x, y, z: 0 })
+    }
+
+    #[test]
+    fn convex_polygon_is_a_fan() {
+        let p = [v(0, 0), v(10, 0), v(10, 10), v(0, 10)];
+        assert_eq!(triangulate(&p).as_slice(), &[[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn reflex_vertex_is_ear_clipped_with_one_winding() {
+        // Vertex 2 is pushed slightly inwards: the fan piece (0, 2, 3)
+        // would wind the other way.
+        let p = [v(0, 0), v(100, 0), v(99, 50), v(100, 100), v(0, 100)];
+        let tris = triangulate(&p);
+        let s: Vec<SnappedVertex> = p.iter().map(|x| x.unwrap()).collect();
+        let mut total = 0;
+        for t in &tris {
+            let a = orient(s[t[0] as usize], s[t[1] as usize], s[t[2] as usize]);
+            assert!(a > 0, "{t:?} winds the wrong way");
+            total += a;
+        }
+        // The pieces tile the polygon: their areas add up to its area.
+        let poly_area: i64 = (1..4).map(|i| orient(s[0], s[i], s[i + 1])).sum();
+        assert_eq!(total, poly_area);
+    }
+
+    extern crate std;
+    use std::vec::Vec;
+}

@@ -949,7 +949,6 @@ fn check_strip_renderer<const S: u32>(
 /// `draw_mesh_cached` (which tests the frustum before looking the colour
 /// up). Images are identical; only `Stats` differ.
 #[test]
-#[ignore = "BUG: draw_mesh_cached counts a triangle with a missing colour (PerTriangle/PerVertex list too short) under culled_frustum / culled_backface / culled_degenerate / rejected_nonfinite when it also fails that test, where draw_mesh counts rejected_index: Stats differ"]
 fn draw_mesh_cached_counts_missing_colours_like_draw_mesh() {
     let positions = [
         Vec3::new(10.0, 0.0, 0.0),
