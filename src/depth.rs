@@ -60,10 +60,100 @@ pub trait DepthBuffer {
     /// Tests `z` (`Z32`) against the value at `index` and, if it passes and
     /// `write` is set, stores it. An index out of range fails the test.
     fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool;
+
+    /// Draws a span of one flat colour: pixels `start..start + len`, where
+    /// pixel `start + n` has depth `Z32 = clamp(z0 + n * dz) >> 16` (`z0`,
+    /// `dz` in `Z32.16`). Returns the pixels written. The default tests
+    /// pixel by pixel; buffers override it with branch-free loops the
+    /// compiler can vectorize.
+    #[allow(clippy::too_many_arguments)]
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        func: DepthFunc,
+        write: bool,
+        px: C,
+    ) -> u32 {
+        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
+            return 0;
+        };
+        let mut written = 0;
+        for (n, cp) in c.iter_mut().enumerate() {
+            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
+                *cp = px;
+                written += 1;
+            }
+        }
+        written
+    }
+}
+
+/// `Z32` at step `n` of a span in `Z32.16` (wrapping, then clamped).
+#[inline(always)]
+pub(crate) fn z32_at(z0: i64, dz: i64, n: usize) -> u32 {
+    let z = z0.wrapping_add(dz.wrapping_mul(n as i64));
+    (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32
+}
+
+/// The branch-free span loop for `Less` / `LessEqual` with depth writes;
+/// `None` where it does not apply.
+macro_rules! fast_flat_span {
+    ($self:ident, $color:ident, $start:ident, $len:ident, $z0:ident, $dz:ident, $func:ident, $write:ident, $px:ident, $shift:expr, $t:ty) => {{
+        let end = $start.saturating_add($len);
+        if $write && matches!($func, DepthFunc::Less | DepthFunc::LessEqual) {
+            let (Some(c), Some(d)) = ($color.get_mut($start..end), $self.get_mut($start..end))
+            else {
+                return 0;
+            };
+            let le = $func == DepthFunc::LessEqual;
+            let mut written = 0u32;
+            for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
+                let z = (z32_at($z0, $dz, n) >> $shift) as $t;
+                let pass = z < *dp || (le && z == *dp);
+                *dp = if pass { z } else { *dp };
+                *cp = if pass { $px } else { *cp };
+                written += pass as u32;
+            }
+            Some(written)
+        } else {
+            None
+        }
+    }};
 }
 
 impl DepthBuffer for [u32] {
     const ENABLED: bool = true;
+
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        func: DepthFunc,
+        write: bool,
+        px: C,
+    ) -> u32 {
+        if let Some(n) = fast_flat_span!(self, color, start, len, z0, dz, func, write, px, 0, u32) {
+            return n;
+        }
+        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
+            return 0;
+        };
+        let mut written = 0;
+        for (n, cp) in c.iter_mut().enumerate() {
+            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
+                *cp = px;
+                written += 1;
+            }
+        }
+        written
+    }
 
     fn depth_len(&self) -> Option<usize> {
         Some(self.len())
@@ -85,6 +175,34 @@ impl DepthBuffer for [u32] {
 
 impl DepthBuffer for [u16] {
     const ENABLED: bool = true;
+
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        func: DepthFunc,
+        write: bool,
+        px: C,
+    ) -> u32 {
+        if let Some(n) = fast_flat_span!(self, color, start, len, z0, dz, func, write, px, 16, u16)
+        {
+            return n;
+        }
+        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
+            return 0;
+        };
+        let mut written = 0;
+        for (n, cp) in c.iter_mut().enumerate() {
+            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
+                *cp = px;
+                written += 1;
+            }
+        }
+        written
+    }
 
     fn depth_len(&self) -> Option<usize> {
         Some(self.len())
@@ -111,6 +229,26 @@ pub struct NoDepth;
 
 impl DepthBuffer for NoDepth {
     const ENABLED: bool = false;
+
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        _: i64,
+        _: i64,
+        _: DepthFunc,
+        _: bool,
+        px: C,
+    ) -> u32 {
+        match color.get_mut(start..start.saturating_add(len)) {
+            Some(c) => {
+                c.fill(px);
+                len as u32
+            }
+            None => 0,
+        }
+    }
 
     fn depth_len(&self) -> Option<usize> {
         None

@@ -325,10 +325,9 @@ impl<'b, P: Pixel, D: StripDepth> StripDrawer<'b, P, D> {
             color.fill(self.background);
             let stats = render(y0, y1, color, depth)?;
             total.pixels_written += stats.pixels_written;
-            let area = Rectangle::new(
-                self.origin + Point::new(0, y0 as i32),
-                Size::new(width, y1 - y0),
-            );
+            // y0 < 2^14; saturating keeps an absurd origin from overflowing.
+            let top = Point::new(self.origin.x, self.origin.y.saturating_add(y0 as i32));
+            let area = Rectangle::new(top, Size::new(width, y1 - y0));
             target
                 .fill_contiguous(&area, color.iter().map(|&p| T::Color::from(p)))
                 .map_err(DrawError::Target)?;

@@ -132,6 +132,8 @@ struct Shader {
     k2: f64,
     /// Depth change per pixel.
     dz: f64,
+    /// The same in `Z32.16`, rounded (saturating).
+    dz_fixed: i64,
     /// Unbiased edge value = biased value - bias.
     bias: [i64; 3],
     /// Colour numerators (r, g, b) and denominator change per pixel.
@@ -169,11 +171,14 @@ impl Shader {
             }
             dc[3] = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
         }
+        let q = dz * 65536.0;
+        let dz_fixed = (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64;
         Shader {
             z0: t.z[0] as f64,
             k1,
             k2,
             dz,
+            dz_fixed,
             bias: [edges[0].bias, edges[1].bias, edges[2].bias],
             dc,
             smooth,
@@ -314,7 +319,28 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
         let covered = edges[0].clip_span(&mut lo, &mut hi)
             && edges[1].clip_span(&mut lo, &mut hi)
             && edges[2].clip_span(&mut lo, &mut hi);
-        if covered {
+        if covered && !shader.smooth {
+            // Flat span: one colour, depth stepped in Z32.16 from the span's
+            // exact start (error below 1/8 LSB over 2^14 pixels), in the
+            // depth buffer's branch-free loop.
+            let e = [
+                edges[0].row + edges[0].step_x * lo,
+                edges[1].row + edges[1].step_x * lo,
+                edges[2].row + edges[2].step_x * lo,
+            ];
+            let z0 = shader.start::<D>(t, e).z;
+            let px = C::from_fragment(t.flat, t.id);
+            written += strip.depth.flat_span(
+                strip.color,
+                base + lo as usize,
+                (hi - lo + 1) as usize,
+                (z0 * 65536.0) as i64,
+                shader.dz_fixed,
+                strip.depth_func,
+                strip.depth_write,
+                px,
+            );
+        } else if covered {
             let mut e = [
                 edges[0].row + edges[0].step_x * lo,
                 edges[1].row + edges[1].step_x * lo,
