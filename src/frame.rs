@@ -198,6 +198,9 @@ pub struct Stats {
     pub clipped: u32,
     /// Set-up triangles stored (what the rasterizer will draw).
     pub stored: u32,
+    /// [`StripRenderer`](crate::StripRenderer) only: skipped before any
+    /// setup because every vertex lies above or below the strip.
+    pub outside_strip: u32,
 }
 
 impl Stats {
@@ -211,6 +214,7 @@ impl Stats {
         self.rejected_index += o.rejected_index;
         self.clipped += o.clipped;
         self.stored += o.stored;
+        self.outside_strip += o.outside_strip;
     }
 }
 

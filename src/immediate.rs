@@ -8,7 +8,10 @@
 //! into the one strip it holds. The caller submits the scene once per
 //! strip. The pixels are bit-identical to [`Frame::render_rows`]
 //! (`crate::Frame::render_rows`) for the same rows: it is the same code in
-//! the same order, only without the store.
+//! the same order, only without the store. Triangles wholly above or below
+//! the strip are skipped before clipping and setup (counted in
+//! [`Stats::outside_strip`](crate::Stats::outside_strip)), so each strip
+//! pays the full pipeline only for the triangles that reach it.
 
 use crate::clip::ClipVertex;
 use crate::color::Pixel;
@@ -46,6 +49,9 @@ use embedded_graphics_core::pixelcolor::Rgb888;
 pub struct StripRenderer<'b, C, D: ?Sized, const S: u32 = 8> {
     config: Config,
     guard: (f32, f32),
+    /// NDC y above which (and below which) a vertex lies beyond the strip,
+    /// with a quarter-pixel margin: `(top, bottom)`.
+    slab: (f32, f32),
     strip: Strip<'b, C, D>,
     stats: Stats,
     render: RenderStats,
@@ -82,6 +88,13 @@ impl<'b, C: Pixel, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b, C, D
         Ok(StripRenderer {
             config,
             guard: guard_band_ndc::<S>(config.width, config.height),
+            slab: {
+                let h = config.height as f32;
+                (
+                    1.0 - 2.0 * (y0 as f32 + 0.25) / h,
+                    1.0 - 2.0 * (y1 as f32 - 0.25) / h,
+                )
+            },
             strip: Strip {
                 width: config.width as usize,
                 y0,
@@ -108,8 +121,26 @@ impl<'b, C: Pixel, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b, C, D
 
     /// Submits and draws one clip-space triangle.
     pub fn push_triangle(&mut self, tri: [ClipVertex; 3], id: u32) {
-        let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
         self.stats.submitted += 1;
+        // Every vertex in front of the eye and all above (or all below) the
+        // strip: no pixel centre of the strip can be covered. The quarter
+        // pixel margin dwarfs float rounding and snapping (half a
+        // subpixel), so this never decides coverage.
+        // Triangles outside the whole frame are left to the frustum test,
+        // so a strip covering the frame counts exactly what a `Frame` does.
+        let (top, bottom) = self.slab;
+        let whole = self.strip.y0 == 0 && self.strip.y1 == self.config.height;
+        if !whole
+            && tri.iter().all(|v| v.pos.w > 0.0 && v.pos.is_finite())
+            && ((tri.iter().all(|v| v.pos.y > v.pos.w * top)
+                && !tri.iter().all(|v| v.pos.y > v.pos.w))
+                || (tri.iter().all(|v| v.pos.y < v.pos.w * bottom)
+                    && !tri.iter().all(|v| v.pos.y < -v.pos.w)))
+        {
+            self.stats.outside_strip += 1;
+            return;
+        }
+        let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
         process::<S>(
             &self.config,
             self.guard,
