@@ -54,6 +54,11 @@ pub trait DepthBuffer {
     /// `false` only for [`NoDepth`]: no depth value is computed at all.
     const ENABLED: bool;
 
+    /// Whether the buffer keeps more than 24 bits, so depth is interpolated
+    /// in `f64` (`u32`); `u16` buffers use `f32`, which is exact enough for
+    /// 16 bits and cheap on cores without a double-precision FPU.
+    const WIDE: bool;
+
     /// The number of depth values held, or `None` without a buffer.
     fn depth_len(&self) -> Option<usize>;
 
@@ -127,6 +132,7 @@ macro_rules! fast_flat_span {
 
 impl DepthBuffer for [u32] {
     const ENABLED: bool = true;
+    const WIDE: bool = true;
 
     fn flat_span<C: Copy>(
         &mut self,
@@ -175,6 +181,7 @@ impl DepthBuffer for [u32] {
 
 impl DepthBuffer for [u16] {
     const ENABLED: bool = true;
+    const WIDE: bool = false;
 
     fn flat_span<C: Copy>(
         &mut self,
@@ -229,6 +236,7 @@ pub struct NoDepth;
 
 impl DepthBuffer for NoDepth {
     const ENABLED: bool = false;
+    const WIDE: bool = false;
 
     fn flat_span<C: Copy>(
         &mut self,

@@ -22,15 +22,18 @@
 //!
 //! Depth is the plane through the three `Z32` vertex depths, evaluated from
 //! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
-//! in `f64` at the start of each run of pixels (a row's first covered pixel
-//! for small triangles, every [`RESYNC`] pixels of a span) and stepped by its `f64`
-//! gradient in between. At a covered pixel each term is at most `2^32`, so
-//! the error is far below one `Z32` LSB (under `2^-10` with the steps) and
-//! the written `Z32` is the floor of the exact plane value, or one off only
-//! where that value lies that close to an integer. Runs start where the
-//! triangle's geometry says (its box, its exact spans), never where a strip
-//! starts, so the result does not depend on the strip split (IEEE `f64` is
-//! deterministic, in software on FPU-less cores too).
+//! at the start of each run of pixels (a row's first covered pixel for
+//! small triangles, every [`RESYNC`] pixels of a span) and stepped by its
+//! gradient in between; flat spans step it in `Z32.16` integers. The float
+//! is `f64` for `u32` buffers: each term is at most `2^32` at a covered
+//! pixel, so the error is far below one `Z32` LSB and the written value is
+//! the floor of the exact plane value, or one off only where that value
+//! lies that close to an integer. `u16` buffers use `f32` (error about
+//! `2^-8` of a `Z16` LSB; no software `f64` on single-precision FPUs).
+//! Runs start where the triangle's geometry says (its box, its exact
+//! spans), never where a strip starts, so the result does not depend on the
+//! strip split (IEEE arithmetic is deterministic, in software on FPU-less
+//! cores too).
 //!
 //! Colour, when it varies, is perspective-correct: `sum(E_k c_k / w_k) /
 //! sum(E_k / w_k)` with the exact edge values converted to `f32` at the
@@ -123,15 +126,80 @@ const SMALL_WIDTH: u16 = 24;
 /// pixels along a span, so float stepping error stays bounded.
 const RESYNC: i64 = 16;
 
+/// The float type depth is interpolated in: `f64` for `Z32` buffers,
+/// `f32` where only 16 bits are kept (and on FPU-less or single-precision
+/// cores that saves software `f64`): terms up to `2^32` carry an `f32`
+/// error of about `2^8` `Z32` units, `2^-8` of a `Z16` LSB.
+trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self> {
+    const ZERO: Self;
+    fn from_i64(v: i64) -> Self;
+    fn from_u32(v: u32) -> Self;
+    fn recip(self) -> Self;
+    /// Saturating, flooring conversion (NaN gives 0).
+    fn to_u32(self) -> u32;
+    /// `self * 2^16`, rounded half away from zero, saturating.
+    fn to_fixed16(self) -> i64;
+}
+
+impl Real for f64 {
+    const ZERO: f64 = 0.0;
+    #[inline(always)]
+    fn from_i64(v: i64) -> f64 {
+        v as f64
+    }
+    #[inline(always)]
+    fn from_u32(v: u32) -> f64 {
+        v as f64
+    }
+    #[inline(always)]
+    fn recip(self) -> f64 {
+        1.0 / self
+    }
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn to_fixed16(self) -> i64 {
+        let q = self * 65536.0;
+        (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
+    }
+}
+
+impl Real for f32 {
+    const ZERO: f32 = 0.0;
+    #[inline(always)]
+    fn from_i64(v: i64) -> f32 {
+        v as f32
+    }
+    #[inline(always)]
+    fn from_u32(v: u32) -> f32 {
+        v as f32
+    }
+    #[inline(always)]
+    fn recip(self) -> f32 {
+        1.0 / self
+    }
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn to_fixed16(self) -> i64 {
+        let q = self * 65536.0;
+        (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
+    }
+}
+
 /// Per-triangle constants for shading a covered pixel.
-struct Shader {
-    /// `Z0` as `f64`.
-    z0: f64,
+struct Shader<R> {
+    /// `Z0`.
+    z0: R,
     /// `(Z1 - Z0) / area` and `(Z2 - Z0) / area`.
-    k1: f64,
-    k2: f64,
+    k1: R,
+    k2: R,
     /// Depth change per pixel.
-    dz: f64,
+    dz: R,
     /// The same in `Z32.16`, rounded (saturating).
     dz_fixed: i64,
     /// Unbiased edge value = biased value - bias.
@@ -143,19 +211,20 @@ struct Shader {
 
 /// Interpolants at one pixel: depth and colour numerators/denominator.
 #[derive(Clone, Copy)]
-struct Acc {
-    z: f64,
+struct Acc<R> {
+    z: R,
     c: [f32; 4],
 }
 
-impl Shader {
-    fn new<C: Pixel, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Shader {
-        let (mut k1, mut k2, mut dz) = (0.0, 0.0, 0.0);
+impl<R: Real> Shader<R> {
+    fn new<C: Pixel, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Self {
+        let (mut k1, mut k2, mut dz) = (R::ZERO, R::ZERO, R::ZERO);
         if D::ENABLED {
-            let inv_area = 1.0 / t.area as f64;
-            k1 = (t.z[1] as f64 - t.z[0] as f64) * inv_area;
-            k2 = (t.z[2] as f64 - t.z[0] as f64) * inv_area;
-            dz = k1 * edges[1].step_x as f64 + k2 * edges[2].step_x as f64;
+            let inv_area = R::from_i64(t.area).recip();
+            let z0 = t.z[0] as i64;
+            k1 = R::from_i64(t.z[1] as i64 - z0) * inv_area;
+            k2 = R::from_i64(t.z[2] as i64 - z0) * inv_area;
+            dz = k1 * R::from_i64(edges[1].step_x) + k2 * R::from_i64(edges[2].step_x);
         }
         let smooth = C::SHADED && t.smooth;
         let mut dc = [0.0f32; 4];
@@ -171,14 +240,12 @@ impl Shader {
             }
             dc[3] = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
         }
-        let q = dz * 65536.0;
-        let dz_fixed = (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64;
         Shader {
-            z0: t.z[0] as f64,
+            z0: R::from_u32(t.z[0]),
             k1,
             k2,
             dz,
-            dz_fixed,
+            dz_fixed: dz.to_fixed16(),
             bias: [edges[0].bias, edges[1].bias, edges[2].bias],
             dc,
             smooth,
@@ -188,16 +255,16 @@ impl Shader {
     /// The interpolants at the pixel whose biased edge values are `e`,
     /// evaluated from the exact edge values.
     #[inline(always)]
-    fn start<D: DepthBuffer + ?Sized>(&self, t: &SetupTriangle, e: [i64; 3]) -> Acc {
+    fn start<D: DepthBuffer + ?Sized>(&self, t: &SetupTriangle, e: [i64; 3]) -> Acc<R> {
         let e = [
             e[0] - self.bias[0],
             e[1] - self.bias[1],
             e[2] - self.bias[2],
         ];
         let z = if D::ENABLED {
-            self.z0 + self.k1 * e[1] as f64 + self.k2 * e[2] as f64
+            self.z0 + self.k1 * R::from_i64(e[1]) + self.k2 * R::from_i64(e[2])
         } else {
-            0.0
+            R::ZERO
         };
         let mut c = [0.0f32; 4];
         if self.smooth {
@@ -213,9 +280,9 @@ impl Shader {
 
     /// Moves the interpolants one pixel to the right.
     #[inline(always)]
-    fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc) {
+    fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc<R>) {
         if D::ENABLED {
-            a.z += self.dz;
+            a.z = a.z + self.dz;
         }
         if self.smooth {
             for k in 0..4 {
@@ -232,10 +299,10 @@ impl Shader {
         t: &SetupTriangle,
         strip: &mut Strip<'_, C, D>,
         idx: usize,
-        a: &Acc,
+        a: &Acc<R>,
     ) -> u32 {
         if D::ENABLED {
-            let z32 = a.z as u32; // saturating, floors
+            let z32 = a.z.to_u32(); // saturating, floors
             if !strip
                 .depth
                 .test_and_set(idx, z32, strip.depth_func, strip.depth_write)
@@ -261,7 +328,20 @@ impl Shader {
 }
 
 /// Draws one triangle into the strip; returns the number of pixels written.
+#[inline]
 pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
+    t: &SetupTriangle,
+    strip: &mut Strip<'_, C, D>,
+) -> u32 {
+    if D::WIDE {
+        draw_in::<S, C, D, f64>(t, strip)
+    } else {
+        draw_in::<S, C, D, f32>(t, strip)
+    }
+}
+
+/// [`draw`] with depth interpolated in `R`.
+fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
     t: &SetupTriangle,
     strip: &mut Strip<'_, C, D>,
 ) -> u32 {
@@ -280,7 +360,7 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
         Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
         Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
     ];
-    let shader = Shader::new::<C, D>(t, &edges);
+    let shader = Shader::<R>::new::<C, D>(t, &edges);
     let max_n = (t.max_x - t.min_x) as i64;
     let mut written = 0u32;
     let mut base = (row_first - strip.y0) as usize * strip.width + t.min_x as usize;
@@ -292,7 +372,7 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
             let mut e = [edges[0].row, edges[1].row, edges[2].row];
             // Interpolants start at the row's first covered pixel, where
             // every edge value is non-negative (no cancellation).
-            let mut acc: Option<Acc> = None;
+            let mut acc: Option<Acc<R>> = None;
             for n in 0..=max_n as usize {
                 if (e[0] | e[1] | e[2]) >= 0 {
                     let a = acc.get_or_insert_with(|| shader.start::<D>(t, e));
@@ -334,7 +414,7 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
                 strip.color,
                 base + lo as usize,
                 (hi - lo + 1) as usize,
-                (z0 * 65536.0) as i64,
+                z0.to_fixed16(),
                 shader.dz_fixed,
                 strip.depth_func,
                 strip.depth_write,
