@@ -529,20 +529,29 @@ impl<'s, const S: u32> Frame<'s, S> {
             submitted: 1,
             ..Stats::default()
         };
-        let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
-        process::<S>(&self.config, self.guard, &tri, id, &mut stats, &mut out);
-        let free = self.storage.len() - self.len;
-        if out.len() > free {
+        // Pieces go straight into storage; if it fills up, they are taken
+        // back (the length is restored) and nothing is counted.
+        let start = self.len;
+        let storage = &mut *self.storage;
+        let len = &mut self.len;
+        let mut wanted = 0usize;
+        let ok = process::<S>(&self.config, self.guard, &tri, id, &mut stats, |t| {
+            wanted += 1;
+            match storage.get_mut(*len) {
+                Some(slot) => {
+                    *slot = t;
+                    *len += 1;
+                    true
+                }
+                None => false,
+            }
+        });
+        if !ok {
+            self.len = start;
             return Err(Error::StorageFull {
                 capacity: self.storage.len(),
-                needed: out.len() - free,
+                needed: start + wanted - self.storage.len(),
             });
-        }
-        for t in out {
-            if let Some(slot) = self.storage.get_mut(self.len) {
-                *slot = t;
-                self.len += 1;
-            }
         }
         self.stats.add(&stats);
         Ok(())
@@ -587,11 +596,7 @@ impl<'s, const S: u32> Frame<'s, S> {
     /// processed in parallel, by frames of the same configuration, before
     /// [`Frame::draw_mesh_processed`].
     pub fn process_vertices(&self, mvp: &Mat4, positions: &[Vec3], out: &mut [ProcessedVertex]) {
-        let c = &self.config;
-        let (gx, gy) = self.guard;
-        for (p, v) in positions.iter().zip(out.iter_mut()) {
-            *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
-        }
+        process_vertices::<S>(&self.config, self.guard, mvp, positions, out);
     }
 
     /// The triangle stage of [`Frame::draw_mesh_cached`]: submits the
@@ -605,120 +610,40 @@ impl<'s, const S: u32> Frame<'s, S> {
         first_id: u32,
         cache: &[ProcessedVertex],
     ) -> Result<(), Error> {
-        let c = self.config;
         let start_len = self.len;
-        let start_stats = self.stats;
         let mut stats = Stats::default();
-        for (i, idx) in mesh.indices.iter().enumerate() {
-            let id = first_id.wrapping_add(i as u32);
-            stats.submitted += 1;
-            let (Some(a), Some(b), Some(d)) = (
-                cache.get(idx[0] as usize),
-                cache.get(idx[1] as usize),
-                cache.get(idx[2] as usize),
-            ) else {
-                stats.rejected_index += 1;
-                continue;
-            };
-            let v = [a, b, d];
-            // A missing colour counts as a bad index first, as in `draw_mesh`.
-            let colors_ok = match mesh.colors {
-                MeshColors::Uniform(_) => true,
-                MeshColors::PerTriangle(cs) => i < cs.len(),
-                MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
-            };
-            if !colors_ok {
-                stats.rejected_index += 1;
-                continue;
-            }
-            let color = |k: usize| -> Option<[f32; 3]> {
-                Some(rgb_f32(match mesh.colors {
-                    MeshColors::Uniform(c) => c,
-                    MeshColors::PerTriangle(cs) => *cs.get(i)?,
-                    MeshColors::PerVertex(cs) => *cs.get(idx[k] as usize)?,
-                }))
-            };
-            let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
-            if or & NONFINITE != 0 {
-                stats.rejected_nonfinite += 1;
-                continue;
-            }
-            if and & outcode::FRUSTUM != 0 {
-                stats.culled_frustum += 1;
-                continue;
-            }
-            if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
-                // Fast path: vertices already snapped; the triangle goes
-                // straight into its storage slot.
-                let g = match setup_geometry::<S>(
-                    &[a.snap, b.snap, d.snap],
-                    c.width,
-                    c.height,
-                    c.cull,
-                    c.front_face,
-                ) {
-                    Ok(g) => g,
-                    Err(r) => {
-                        count_rejected(&mut stats, r);
-                        continue;
-                    }
-                };
-                let (Some(c0), Some(c1), Some(c2)) = (color(0), color(1), color(2)) else {
-                    stats.rejected_index += 1;
-                    continue;
-                };
-                let Some(slot) = self.storage.get_mut(self.len) else {
-                    self.len = start_len;
-                    self.stats = start_stats;
-                    return Err(Error::StorageFull {
-                        capacity: self.storage.len(),
-                        needed: mesh.indices.len() - i,
-                    });
-                };
-                *slot = g.finish([a.inv_w, b.inv_w, d.inv_w], [c0, c1, c2], id);
-                self.len += 1;
-                stats.stored += 1;
-                continue;
-            }
-            let (Some(c0), Some(c1), Some(c2)) = (color(0), color(1), color(2)) else {
-                stats.rejected_index += 1;
-                continue;
-            };
-            let tri = [
-                ClipVertex {
-                    pos: v[0].pos,
-                    color: c0,
-                },
-                ClipVertex {
-                    pos: v[1].pos,
-                    color: c1,
-                },
-                ClipVertex {
-                    pos: v[2].pos,
-                    color: c2,
-                },
-            ];
-            let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
-            process::<S>(&c, self.guard, &tri, id, &mut stats, &mut out);
-            for t in out {
-                match self.storage.get_mut(self.len) {
-                    Some(slot) => {
-                        *slot = t;
-                        self.len += 1;
-                    }
-                    None => {
-                        self.len = start_len;
-                        self.stats = start_stats;
-                        return Err(Error::StorageFull {
-                            capacity: self.storage.len(),
-                            needed: mesh.indices.len() - i,
-                        });
-                    }
+        let storage = &mut *self.storage;
+        let len = &mut self.len;
+        let result = triangles_processed::<S>(
+            &self.config,
+            self.guard,
+            mesh,
+            first_id,
+            cache,
+            &mut stats,
+            |_| false,
+            |t| match storage.get_mut(*len) {
+                Some(slot) => {
+                    *slot = t;
+                    *len += 1;
+                    true
                 }
+                None => false,
+            },
+        );
+        match result {
+            Ok(()) => {
+                self.stats.add(&stats);
+                Ok(())
+            }
+            Err(i) => {
+                self.len = start_len;
+                Err(Error::StorageFull {
+                    capacity: self.storage.len(),
+                    needed: mesh.indices.len() - i,
+                })
             }
         }
-        self.stats.add(&stats);
-        Ok(())
     }
 
     /// Submits every triangle of `mesh`, transformed by `mvp` (object to
@@ -913,21 +838,23 @@ fn count_rejected(stats: &mut Stats, r: Rejected) {
     }
 }
 
-/// Runs one triangle through cull, clip and setup into `out`.
+/// Runs one triangle through cull, clip and setup, handing each set-up
+/// piece (at most 7) to `sink`, which returns `false` when it cannot take
+/// it; then this returns `false` at once (the caller rolls back).
 pub(crate) fn process<const S: u32>(
     c: &Config,
     guard: (f32, f32),
     tri: &[ClipVertex; 3],
     id: u32,
     stats: &mut Stats,
-    out: &mut heapless::Vec<SetupTriangle, 7>,
-) {
+    mut sink: impl FnMut(SetupTriangle) -> bool,
+) -> bool {
     if !tri
         .iter()
         .all(|v| v.pos.is_finite() && v.color.iter().all(|c| c.is_finite()))
     {
         stats.rejected_nonfinite += 1;
-        return;
+        return true;
     }
     let (gx, gy) = guard;
     let codes = [
@@ -937,24 +864,26 @@ pub(crate) fn process<const S: u32>(
     ];
     if codes[0] & codes[1] & codes[2] & outcode::FRUSTUM != 0 {
         stats.culled_frustum += 1;
-        return;
+        return true;
     }
     let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
     if crossing == 0 {
         match setup::<S>(tri, c.width, c.height, c.cull, c.front_face, id) {
             Ok(t) => {
-                let _ = out.push(t);
+                if !sink(t) {
+                    return false;
+                }
                 stats.stored += 1;
             }
             Err(r) => count_rejected(stats, r),
         }
-        return;
+        return true;
     }
     stats.clipped += 1;
     let poly = clip_triangle(tri, crossing, gx, gy);
     if poly.len() < 3 {
         stats.culled_frustum += 1;
-        return;
+        return true;
     }
     // Snap the polygon's vertices once; split it into triangles that all
     // wind the same way (a fan, unless snapping made the polygon slightly
@@ -965,6 +894,7 @@ pub(crate) fn process<const S: u32>(
         let _ = snapped.push(snap::<S>(p.x, p.y, p.z, p.w, c.width, c.height));
     }
     let mut first_reason = None;
+    let mut stored = 0;
     for [a, b, d] in triangulate(&snapped) {
         let (a, b, d) = (a as usize, b as usize, d as usize);
         let (Some(sa), Some(sb), Some(sd)) = (snapped[a], snapped[b], snapped[d]) else {
@@ -974,12 +904,14 @@ pub(crate) fn process<const S: u32>(
         match setup_geometry::<S>(&[sa, sb, sd], c.width, c.height, c.cull, c.front_face) {
             Ok(g) => {
                 let (pa, pb, pd) = (&poly[a], &poly[b], &poly[d]);
-                // At most 7 pieces from a 9-gon: cannot fail.
-                let _ = out.push(g.finish(
+                if !sink(g.finish(
                     [1.0 / pa.pos.w, 1.0 / pb.pos.w, 1.0 / pd.pos.w],
                     [pa.color, pb.color, pd.color],
                     id,
-                ));
+                )) {
+                    return false;
+                }
+                stored += 1;
                 stats.stored += 1;
             }
             Err(r) => {
@@ -987,9 +919,10 @@ pub(crate) fn process<const S: u32>(
             }
         }
     }
-    if out.is_empty() {
+    if stored == 0 {
         count_rejected(stats, first_reason.unwrap_or(Rejected::Degenerate));
     }
+    true
 }
 
 /// Checks a row range and buffer sizes against a frame.
@@ -1156,4 +1089,113 @@ mod tests {
             ));
         }
     }
+}
+
+/// The vertex stage: transform, outcode and (where no clipping can touch
+/// the vertex) snap, pairwise from `positions` into `out`.
+pub(crate) fn process_vertices<const S: u32>(
+    c: &Config,
+    guard: (f32, f32),
+    mvp: &Mat4,
+    positions: &[Vec3],
+    out: &mut [ProcessedVertex],
+) {
+    let (gx, gy) = guard;
+    for (p, v) in positions.iter().zip(out.iter_mut()) {
+        *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
+    }
+}
+
+/// The triangle stage over processed vertices, shared by [`Frame`] and
+/// [`StripRenderer`](crate::StripRenderer): every set-up triangle goes to
+/// `sink` (which returns `false` when it cannot take it: then this returns
+/// `Err(i)` for the triangle `i` that did not fit). Triangles for which
+/// `skip` (given the three clip positions) says so are counted in
+/// `outside_strip` after the frustum test.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn triangles_processed<const S: u32>(
+    c: &Config,
+    guard: (f32, f32),
+    mesh: &Mesh<'_>,
+    first_id: u32,
+    cache: &[ProcessedVertex],
+    stats: &mut Stats,
+    mut skip: impl FnMut([Vec4; 3]) -> bool,
+    mut sink: impl FnMut(SetupTriangle) -> bool,
+) -> Result<(), usize> {
+    for (i, idx) in mesh.indices.iter().enumerate() {
+        let id = first_id.wrapping_add(i as u32);
+        stats.submitted += 1;
+        let (Some(a), Some(b), Some(d)) = (
+            cache.get(idx[0] as usize),
+            cache.get(idx[1] as usize),
+            cache.get(idx[2] as usize),
+        ) else {
+            stats.rejected_index += 1;
+            continue;
+        };
+        // A missing colour counts as a bad index first, as in `draw_mesh`.
+        let colors_ok = match mesh.colors {
+            MeshColors::Uniform(_) => true,
+            MeshColors::PerTriangle(cs) => i < cs.len(),
+            MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
+        };
+        if !colors_ok {
+            stats.rejected_index += 1;
+            continue;
+        }
+        let color = |k: usize| -> [f32; 3] {
+            rgb_f32(match mesh.colors {
+                MeshColors::Uniform(c) => c,
+                MeshColors::PerTriangle(cs) => cs.get(i).copied().unwrap_or_default(),
+                MeshColors::PerVertex(cs) => cs.get(idx[k] as usize).copied().unwrap_or_default(),
+            })
+        };
+        let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
+        if or & NONFINITE != 0 {
+            stats.rejected_nonfinite += 1;
+            continue;
+        }
+        if and & outcode::FRUSTUM != 0 {
+            stats.culled_frustum += 1;
+            continue;
+        }
+        if skip([a.pos, b.pos, d.pos]) {
+            stats.outside_strip += 1;
+            continue;
+        }
+        if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
+            // Fast path: vertices already snapped.
+            match setup_geometry::<S>(
+                &[a.snap, b.snap, d.snap],
+                c.width,
+                c.height,
+                c.cull,
+                c.front_face,
+            ) {
+                Ok(g) => {
+                    let t = g.finish(
+                        [a.inv_w, b.inv_w, d.inv_w],
+                        [color(0), color(1), color(2)],
+                        id,
+                    );
+                    if !sink(t) {
+                        return Err(i);
+                    }
+                    stats.stored += 1;
+                }
+                Err(r) => count_rejected(stats, r),
+            }
+            continue;
+        }
+        let v = [a, b, d];
+        let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
+            pos: v[k].pos,
+            color: color(k),
+        });
+        if !process::<S>(c, guard, &tri, id, stats, &mut sink) {
+            return Err(i);
+        }
+    }
+    Ok(())
 }

@@ -18,11 +18,11 @@ use crate::color::Pixel;
 use crate::depth::DepthBuffer;
 use crate::fixed::guard_band_ndc;
 use crate::frame::{
-    check_rows, check_size, process, rgb_f32, Config, Error, Mesh, RenderStats, Stats,
+    check_rows, check_size, process, process_vertices, rgb_f32, triangles_processed, Config, Error,
+    Mesh, ProcessedVertex, RenderStats, Stats,
 };
-use crate::math::{Mat4, Vec4};
+use crate::math::{Mat4, Vec3, Vec4};
 use crate::raster::{draw, Strip};
-use crate::setup::SetupTriangle;
 use embedded_graphics_core::pixelcolor::Rgb888;
 
 /// Draws triangles straight into rows `y0..y1` of a frame, at `S` subpixel
@@ -140,18 +140,52 @@ impl<'b, C: Pixel, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b, C, D
             self.stats.outside_strip += 1;
             return;
         }
-        let mut out: heapless::Vec<SetupTriangle, 7> = heapless::Vec::new();
-        process::<S>(
+        let strip = &mut self.strip;
+        let render = &mut self.render;
+        process::<S>(&self.config, self.guard, &tri, id, &mut self.stats, |t| {
+            render.pixels_written += draw::<S, C, D>(&t, strip) as u64;
+            true
+        });
+    }
+
+    /// The vertex stage for [`StripRenderer::draw_mesh_processed`]: like
+    /// [`Frame::process_vertices`](crate::Frame::process_vertices). The
+    /// result depends on the frame, not the strip: process a mesh once per
+    /// frame and draw it into every strip.
+    pub fn process_vertices(&self, mvp: &Mat4, positions: &[Vec3], out: &mut [ProcessedVertex]) {
+        process_vertices::<S>(&self.config, self.guard, mvp, positions, out);
+    }
+
+    /// Draws the triangles of `mesh` from vertices processed once per frame
+    /// (entry `i` for `mesh.positions[i]`), skipping those wholly above or
+    /// below the strip: the cheap way to draw a frame strip by strip.
+    pub fn draw_mesh_processed(
+        &mut self,
+        mesh: &Mesh<'_>,
+        first_id: u32,
+        cache: &[ProcessedVertex],
+    ) {
+        let (top, bottom) = self.slab;
+        let whole = self.strip.y0 == 0 && self.strip.y1 == self.config.height;
+        let strip = &mut self.strip;
+        let render = &mut self.render;
+        let _ = triangles_processed::<S>(
             &self.config,
             self.guard,
-            &tri,
-            id,
+            mesh,
+            first_id,
+            cache,
             &mut self.stats,
-            &mut out,
+            |p| {
+                !whole
+                    && p.iter().all(|v| v.w > 0.0)
+                    && (p.iter().all(|v| v.y > v.w * top) || p.iter().all(|v| v.y < v.w * bottom))
+            },
+            |t| {
+                render.pixels_written += draw::<S, C, D>(&t, strip) as u64;
+                true
+            },
         );
-        for t in &out {
-            self.render.pixels_written += draw::<S, C, D>(t, &mut self.strip) as u64;
-        }
     }
 
     /// Submits and draws one clip-space triangle with a colour per vertex.
@@ -180,6 +214,78 @@ impl<'b, C: Pixel, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b, C, D
                 None => {
                     self.stats.submitted += 1;
                     self.stats.rejected_index += 1;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::TriangleId;
+    use crate::frame::{Frame, MeshColors};
+    use crate::math::Mat4;
+    use crate::setup::SetupTriangle;
+
+    #[test]
+    fn processed_mesh_through_strips_equals_the_frame() {
+        let positions: [Vec3; 8] = core::array::from_fn(|i| {
+            let b = |k: usize| if i >> k & 1 == 1 { 1.0 } else { -1.0 };
+            Vec3::new(b(0), b(1), b(2))
+        });
+        let indices = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let colors: [Rgb888; 8] = core::array::from_fn(|i| Rgb888::new(30 * i as u8, 200, 90));
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: MeshColors::PerVertex(&colors),
+            bounds: None,
+        };
+        let mut config = Config::new(40, 30);
+        config.cull = crate::CullMode::None;
+        for angle in [0.3f32, 1.1, 2.6] {
+            let mvp = Mat4::perspective(1.0, 40.0 / 30.0, 0.5, 9.0)
+                * Mat4::translation(Vec3::new(0.2, -0.1, -3.5))
+                * Mat4::rotation_y(angle)
+                * Mat4::rotation_x(0.4);
+            let mut st = [SetupTriangle::EMPTY; 64];
+            let mut frame: Frame = Frame::new(config, &mut st).unwrap();
+            frame.draw_mesh(&mesh, &mvp, 3).unwrap();
+            let mut whole = [Rgb888::new(0, 0, 0); 40 * 30];
+            let mut wz = [u16::MAX; 40 * 30];
+            frame.render_rows(0, 30, &mut whole, &mut wz[..]).unwrap();
+            let mut ids = [TriangleId(0); 40 * 30];
+            frame
+                .render_rows(0, 30, &mut ids, &mut crate::NoDepth)
+                .unwrap();
+            let mut cache = [ProcessedVertex::EMPTY; 8];
+            for rows in [1u32, 4, 7, 30] {
+                for y0 in (0..30).step_by(rows as usize) {
+                    let y1 = (y0 + rows).min(30);
+                    let n = (40 * (y1 - y0)) as usize;
+                    let r = (40 * y0) as usize..(40 * y0) as usize + n;
+                    let mut c = [Rgb888::new(0, 0, 0); 40 * 30];
+                    let mut z = [u16::MAX; 40 * 30];
+                    let mut s: StripRenderer<'_, _, _> =
+                        StripRenderer::new(config, y0, y1, &mut c[..n], &mut z[..n]).unwrap();
+                    s.process_vertices(&mvp, &positions, &mut cache);
+                    s.draw_mesh_processed(&mesh, 3, &cache);
+                    assert_eq!(&c[..n], &whole[r.clone()], "rows {y0}..{y1}");
+                    assert_eq!(&z[..n], &wz[r], "rows {y0}..{y1}");
                 }
             }
         }

@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# The firmware example (examples/firmware) under QEMU on three cores, and
+# the core built for RISC-V.
+#
+# For each board: build the firmware, run it (each run wrapped in
+# `timeout`), require exit code 0 (the firmware exits 0 only if its frame's
+# checksum equals the one its build.rs computed on the host) and require
+# the checksum it prints to equal examples/firmware/host-checksums.txt
+# (which std-host/tests/firmware_frame.rs checks on the host). Then the
+# build variants (no depth buffer, flat colour) and the table of flash,
+# RAM and instructions, printed as markdown for docs/embedded.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+
+step() { printf '\n== %s\n' "$*"; }
+
+step "tools: qemu-system-arm, arm-none-eabi-size, rust targets"
+if ! command -v qemu-system-arm >/dev/null || ! command -v arm-none-eabi-size >/dev/null; then
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm binutils-arm-none-eabi >/dev/null
+fi
+rustup target add thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf riscv32imc-unknown-none-elf
+qemu-system-arm --version | head -1
+
+step "core for riscv32imc-unknown-none-elf (no_std, both float backends)"
+cargo build -p microraster --release --target riscv32imc-unknown-none-elf
+cargo build -p microraster --release --target riscv32imc-unknown-none-elf --no-default-features --features micromath
+
+step "firmware crate: rustfmt and clippy (it is outside the workspace)"
+(
+  cd examples/firmware
+  cargo fmt --check
+  for target in thumbv7em-none-eabihf thumbv6m-none-eabi; do
+    cargo clippy -q --release --target "$target" -- -D warnings
+    cargo clippy -q --release --target "$target" --features no-depth,flat -- -D warnings
+  done
+)
+
+expected() { awk -v k="$1" '$1 == k { print $2 }' examples/firmware/host-checksums.txt; }
+want_depth=$(expected depth-u16)
+want_nodepth=$(expected no-depth)
+test -n "$want_depth" && test -n "$want_nodepth"
+
+boards=(
+  "thumbv7em-none-eabihf mps2-an386"
+  "thumbv7m-none-eabi mps2-an385"
+  "thumbv6m-none-eabi microbit"
+)
+variants=("" "flat" "no-depth" "no-depth,flat")
+budget=24576
+log=$root/target/firmware
+mkdir -p "$log"
+rows=()
+failed=0
+
+cd examples/firmware
+for b in "${boards[@]}"; do
+  read -r target board <<<"$b"
+  for features in "${variants[@]}"; do
+    name=${features:-default}
+    step "$board ($target), features: $name"
+    out=$log/$board-${name//,/+}.txt
+    # The documented command; the runner in .cargo/config.toml starts QEMU
+    # under `timeout 300`, and this outer timeout covers the build too.
+    set +e
+    timeout 900 cargo run -q --release --target "$target" --features "$features" </dev/null >"$out" 2>&1
+    rc=$?
+    set -e
+    cat "$out"
+    elf=target/$target/release/microraster-firmware
+    if [ "$rc" -ne 0 ]; then
+      echo "FAIL: $board $name exited $rc"
+      failed=1
+      continue
+    fi
+    got=$(awk '$1 == "checksum" { print $2 }' "$out")
+    case $features in
+      *no-depth*) want=$want_nodepth ;;
+      *) want=$want_depth ;;
+    esac
+    if [ "$got" != "$want" ]; then
+      echo "FAIL: $board $name checksum $got, host-checksums.txt says $want"
+      failed=1
+    fi
+    read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
+    pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
+    perpx=$(sed -n 's/.*per written pixel \([0-9.]*\)$/\1/p' "$out")
+    display=$(sed -n 's/^ *display stand-in (hash) *\([0-9]*\) .*/\1/p' "$out")
+    render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
+    geometry=$(sed -n 's/^ *geometry x [0-9]* strips *\([0-9]*\) .*/\1/p' "$out")
+    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
+    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
+    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
+    ram=$((statics + stack))
+    if [ -z "$features" ] && [ "$ram" -gt "$budget" ]; then
+      echo "FAIL: $board uses $ram B of RAM, over the $budget B budget"
+      failed=1
+    fi
+    rows+=("| $board | $name | $((text + data)) | $statics | $stack | $ram | $frame | $pixels | $perpx | $display | $render_px | $geometry | $raster |")
+  done
+done
+cd "$root"
+
+step "budget table (320x240 Rgb565, four cubes)"
+echo "| board | features | flash B (text+data) | statics B | stack B | RAM B | instructions/frame | pixels written | instr/pixel | of which display stand-in | render instr/pixel | geometry (all strips) | rasterization |"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${rows[@]}"
+
+if [ "$failed" -ne 0 ]; then
+  echo
+  echo "firmware: FAILED"
+  exit 1
+fi
+echo
+echo "firmware: all boards passed"

@@ -1,0 +1,300 @@
+//! # The four cubes on a microcontroller, checked against the host
+//!
+//! This firmware draws microraster's default scene (four cubes, a colour
+//! per face) at 320x240 `Rgb565` with a `u16` depth buffer, the way a
+//! device with a small SPI display would: through a strip buffer of a few
+//! rows, in immediate mode (no setup storage; the scene is submitted again
+//! for every strip), pushed by the core's embedded-graphics adapter
+//! [`StripDrawer`] into a display stand-in that hashes what it receives
+//! (`display.rs`). It runs under QEMU on three cores:
+//!
+//! | QEMU machine | core       | target                  | rows per strip |
+//! |--------------|------------|-------------------------|----------------|
+//! | `mps2-an386` | Cortex-M4F | `thumbv7em-none-eabihf` | 16             |
+//! | `mps2-an385` | Cortex-M3  | `thumbv7m-none-eabi`    | 16             |
+//! | `microbit`   | Cortex-M0  | `thumbv6m-none-eabi`    | 8 (16 KB RAM)  |
+//!
+//! From this folder, with `qemu-system-arm` on the path (`apt-get install
+//! qemu-system-arm`) and the target added (`rustup target add ...`):
+//!
+//! ```text
+//! cargo run --release --target thumbv7em-none-eabihf
+//! cargo run --release --target thumbv7m-none-eabi
+//! cargo run --release --target thumbv6m-none-eabi
+//! ```
+//!
+//! `build.rs` picks the board's `memory/*.x` and strip height from the
+//! target, and renders the same frame on the host, with the same core
+//! crate, by another path (one `Frame`, one 240-row strip), to embed the
+//! host's checksum. The firmware prints over semihosting the frame's
+//! checksum and the host's, the instructions the frame took (SysTick under
+//! `-icount shift=0`, see `clock.rs`) and where they went, the pixels
+//! written, and its RAM: statics plus the stack's high-water mark (the
+//! stack is painted at reset by cortex-m-rt's `paint-stack`, and scanned
+//! after the frame). It exits 0 only if the checksums are equal and the
+//! stack stayed inside its RAM; QEMU passes the exit code on.
+//!
+//! Features: `no-depth` draws without a depth buffer (painter's order; the
+//! host renders the same) and `flat` with a pixel type that never asks for
+//! interpolated colour; each leaves that code out of the binary (see
+//! `docs/embedded.md` for what that saves).
+
+#![no_std]
+#![no_main]
+
+mod clock;
+mod display;
+
+use clock::Clock;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use display::HashDisplay;
+#[cfg(feature = "flat")]
+use microraster::pixelcolor::Rgb888;
+use microraster::pixelcolor::{Rgb565, RgbColor};
+use microraster::{Config, ProcessedVertex, StripDrawer, StripRenderer};
+use microraster_scenes::cubes;
+use panic_semihosting as _;
+
+// BOARD, CORE, STRIP_ROWS and HOST_CHECKSUM, written by build.rs.
+include!(concat!(env!("OUT_DIR"), "/board.rs"));
+
+const WIDTH: u32 = 320;
+const HEIGHT: u32 = 240;
+const STRIP_LEN: usize = WIDTH as usize * STRIP_ROWS;
+
+/// The strip buffer's pixel: the display's own `Rgb565`, or with `flat`
+/// [`Flat565`].
+#[cfg(not(feature = "flat"))]
+type StripPixel = Rgb565;
+#[cfg(feature = "flat")]
+type StripPixel = Flat565;
+
+/// An `Rgb565` pixel that never asks for interpolated colour
+/// (`SHADED = false`): the rasterizer hands it each triangle's flat colour
+/// (its first vertex's), and the perspective-correct colour code is never
+/// instantiated. For the cubes, flat per face, the pixels are the same.
+#[cfg(feature = "flat")]
+#[derive(Clone, Copy)]
+struct Flat565(Rgb565);
+
+#[cfg(feature = "flat")]
+impl microraster::Pixel for Flat565 {
+    const SHADED: bool = false;
+    #[inline]
+    fn from_fragment(rgb: Rgb888, _: u32) -> Self {
+        Flat565(Rgb565::from(rgb))
+    }
+}
+
+#[cfg(feature = "flat")]
+impl From<Flat565> for Rgb565 {
+    #[inline]
+    fn from(p: Flat565) -> Rgb565 {
+        p.0
+    }
+}
+
+const BLACK: StripPixel = {
+    #[cfg(feature = "flat")]
+    {
+        Flat565(Rgb565::BLACK)
+    }
+    #[cfg(not(feature = "flat"))]
+    {
+        Rgb565::BLACK
+    }
+};
+
+/// Submits the four cubes to one strip (the matrices are computed once per
+/// frame; triangle ids as in `cubes::for_each_cube`).
+fn submit<D>(strip: &mut StripRenderer<'_, StripPixel, D>, mvps: &[microraster::Mat4; 4])
+where
+    D: microraster::DepthBuffer + ?Sized,
+{
+    // Each cube's 8 corners are transformed and snapped once per strip
+    // (not once per triangle corner: 36), and triangles wholly above or
+    // below the strip are skipped before setup.
+    let mut cache = [ProcessedVertex::EMPTY; 8];
+    for (i, mvp) in mvps.iter().enumerate() {
+        strip.process_vertices(mvp, &cubes::POSITIONS, &mut cache);
+        strip.draw_mesh_processed(&cubes::MESH, (i * cubes::CUBE_INDICES.len()) as u32, &cache);
+    }
+}
+
+extern "C" {
+    static _ram_start: u32;
+    static _stack_start: u32;
+    static _stack_end: u32;
+}
+
+/// Statics (`.data` + `.bss`) and the stack's high-water mark, in bytes;
+/// `None` if not one word of paint is left (the stack may have overflowed).
+fn ram_use() -> (usize, Option<usize>) {
+    // Linker symbols: only their addresses are taken.
+    let (ram, top, bottom) = (
+        core::ptr::addr_of!(_ram_start) as usize,
+        core::ptr::addr_of!(_stack_start) as usize,
+        core::ptr::addr_of!(_stack_end) as usize,
+    );
+    let mut a = bottom;
+    // SAFETY: `bottom..top` is the stack region, word aligned, in RAM.
+    while a < top && unsafe { core::ptr::read_volatile(a as *const u32) } == 0xcccc_cccc {
+        a += 4;
+    }
+    (bottom - ram, (a > bottom).then_some(top - a))
+}
+
+/// `n / d` with one decimal, as `(whole, tenths)` (no float formatting
+/// is linked).
+fn ratio(n: u64, d: u64) -> (u64, u64) {
+    let t = (n * 10 + d / 2) / d.max(1);
+    (t / 10, t % 10)
+}
+
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [StripPixel; STRIP_LEN] = [BLACK; STRIP_LEN];
+    #[cfg(not(feature = "no-depth"))]
+    static mut DEPTH: [u16; STRIP_LEN] = [0; STRIP_LEN];
+
+    let p = cortex_m::Peripherals::take().unwrap();
+    let mut clock = Clock::start(p.SYST);
+    let (cal_instr, cal_ticks) = clock.instructions_per_tick();
+    let instr = |ticks: u64| ticks * cal_instr / cal_ticks;
+
+    #[cfg(not(feature = "no-depth"))]
+    let depth = &mut DEPTH[..];
+    #[cfg(feature = "no-depth")]
+    let depth = microraster::NoDepth;
+    let config = Config::new(WIDTH, HEIGHT);
+    let mut drawer = StripDrawer::new(&mut COLOR[..], depth, BLACK);
+    let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
+
+    // The frame: camera matrices, then every strip.
+    let t0 = display.clock.now();
+    let mvps = cubes::mvps(WIDTH, HEIGHT);
+    let drawn = drawer.draw(&mut display, config, |strip| submit(strip, &mvps));
+    let frame_ticks = display.clock.now() - t0;
+
+    let written = match drawn {
+        Ok(stats) => stats.pixels_written,
+        Err(e) => {
+            hprintln!("FAIL: drawing the frame: {:?}", e);
+            exit(false)
+        }
+    };
+    let checksum = display.checksum();
+    let (statics, stack) = ram_use();
+
+    // Where the instructions went, measured apart on the same code: one
+    // strip's clear (done once per strip), and the scene submitted to a
+    // one-row strip (transform, cull, clip and setup of every triangle,
+    // which immediate mode repeats for every strip).
+    let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
+    let mut clock = display.clock;
+    let t = clock.now();
+    COLOR.fill(BLACK);
+    #[cfg(not(feature = "no-depth"))]
+    DEPTH.fill(u16::MAX);
+    let clear_ticks = (clock.now() - t) * strips;
+    let t = clock.now();
+    {
+        let (row, rest) = COLOR.split_at_mut(WIDTH as usize);
+        core::hint::black_box(rest);
+        #[cfg(not(feature = "no-depth"))]
+        let z = &mut DEPTH[..WIDTH as usize];
+        #[cfg(feature = "no-depth")]
+        let z = &mut microraster::NoDepth;
+        let mut one: StripRenderer<'_, StripPixel, _> =
+            StripRenderer::new(config, HEIGHT / 2, HEIGHT / 2 + 1, row, z).unwrap();
+        submit(&mut one, &mvps);
+    }
+    let geometry_ticks = (clock.now() - t) * strips;
+
+    let frame = instr(frame_ticks);
+    let shown = instr(display.ticks);
+    let render = frame - shown;
+    let clears = instr(clear_ticks);
+    let geometry = instr(geometry_ticks).min(render - clears);
+    let raster = render - clears - geometry;
+    let per_px = |n: u64| ratio(n, written);
+
+    hprintln!(
+        "microraster firmware: {} ({}), {}x{} Rgb565, depth {}, colour {}, {} strips of {} rows",
+        BOARD,
+        CORE,
+        WIDTH,
+        HEIGHT,
+        if cfg!(feature = "no-depth") {
+            "none"
+        } else {
+            "u16"
+        },
+        if cfg!(feature = "flat") {
+            "flat"
+        } else {
+            "interpolated"
+        },
+        strips,
+        STRIP_ROWS,
+    );
+    hprintln!("checksum {:#018x}", checksum.unwrap_or(0));
+    hprintln!("host     {:#018x}", HOST_CHECKSUM);
+    let (a, b) = ratio(cal_instr, cal_ticks);
+    hprintln!("instructions per SysTick tick {}.{}", a, b);
+    let (a, b) = per_px(frame);
+    hprintln!(
+        "instructions per frame {}; pixels written {}; per written pixel {}.{}",
+        frame,
+        written,
+        a,
+        b
+    );
+    let (a, b) = per_px(shown);
+    hprintln!("  display stand-in (hash)  {} ({}.{}/px)", shown, a, b);
+    let (a, b) = per_px(render);
+    hprintln!("  render                   {} ({}.{}/px)", render, a, b);
+    let (a, b) = per_px(clears);
+    hprintln!("    strip clears           {} ({}.{}/px)", clears, a, b);
+    let (a, b) = per_px(geometry);
+    hprintln!(
+        "    geometry x {} strips   {} ({}.{}/px)",
+        strips,
+        geometry,
+        a,
+        b
+    );
+    let (a, b) = per_px(raster);
+    hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
+    match stack {
+        Some(s) => hprintln!(
+            "ram statics {} B + stack high-water {} B = {} B",
+            statics,
+            s,
+            statics + s
+        ),
+        None => hprintln!("ram statics {} B + stack: OVERFLOWED", statics),
+    }
+
+    let pass = checksum == Some(HOST_CHECKSUM) && stack.is_some();
+    if pass {
+        hprintln!("PASS: bit-identical to the host");
+    } else {
+        hprintln!("FAIL: the frame differs from the host's, or the stack overflowed");
+    }
+    exit(pass)
+}
+
+/// Ends the run: QEMU exits 0 for success, 1 otherwise.
+fn exit(success: bool) -> ! {
+    debug::exit(if success {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    // Not reached under QEMU; on a board without a debugger, stop here.
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
