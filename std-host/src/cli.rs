@@ -18,7 +18,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use crate::image_out::{image_format, MAX_DIMENSION};
 
 /// Names accepted by `--scene`.
-pub const SCENES: [&str; 1] = ["cubes"];
+/// (`crate::bench_scenes` builds them; see there for what each one is.)
+pub const SCENES: [&str; 5] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad"];
 
 /// Largest `--threads` value accepted.
 pub const MAX_THREADS: usize = 1024;
@@ -329,6 +330,7 @@ mod tests {
         argv.extend_from_slice(args);
         Cli::try_parse_from(argv).map(|cli| match cli.command {
             Command::Render(r) => r,
+            other => panic!("not a render command: {other:?}"),
         })
     }
 

@@ -12,11 +12,15 @@
 #![forbid(unsafe_code)]
 
 pub mod bench;
+pub mod bench_scenes;
 pub mod cli;
 pub mod cliptris;
 pub mod image_out;
 pub mod json;
 pub mod obj;
+pub mod peers;
+pub mod pipeline;
+pub mod reference;
 pub mod render;
 pub mod report;
 

@@ -10,7 +10,7 @@ use microraster::CullMode;
 use microraster_host::cli::{Cli, Command, CullArg, DepthArg, RenderArgs, Source};
 use microraster_host::json::JsonObject;
 use microraster_host::render::{self, DepthKind, RenderOptions, Scene};
-use microraster_host::{cliptris, cubes, image_out, obj};
+use microraster_host::{bench_scenes, cliptris, cubes, image_out, obj};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -31,10 +31,19 @@ fn main() -> ExitCode {
 
 fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
     match args.source() {
-        Source::Scene(name) if name == "cubes" => {
-            Ok(render::cubes_scene(args.width(), args.height()))
+        Source::Scene(name) => {
+            // Built-in scenes keep their own camera (and, for the sphere, its
+            // 45° field of view) unless --eye or --target is given.
+            let custom = args.eye.is_some() || args.target.is_some();
+            let view = bench_scenes::View {
+                width: args.width(),
+                height: args.height(),
+                eye: args.eye,
+                target: args.target,
+                fov: custom.then_some(args.fov),
+            };
+            Ok(bench_scenes::builtin(&name, &view)?.scene)
         }
-        Source::Scene(name) => Err(format!("unknown scene {name:?} (known: cubes)")),
         Source::Obj(path) => {
             let mesh = obj::load_obj(&path)?;
             let (eye, target) = match (args.eye, args.target) {

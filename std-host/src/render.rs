@@ -2,22 +2,23 @@
 //!
 //! Design note: a [`Scene`] is plain owned data (meshes with their
 //! model-view-projection matrix, or raw clip-space triangles). [`render`]
-//! pushes it into one core [`Frame`] (setup storage sized from the triangle
-//! count and grown on [`Error::StorageFull`]), then splits the frame's
-//! buffers into strips of `strip_rows` rows with `chunks_mut`. Strips are
-//! handed to `std::thread::scope` workers through one shared iterator behind
-//! a mutex, so more strips than threads balance the load; each worker owns
-//! its `&mut` rows and clears them before drawing. The core draws triangles
-//! in submission order in every strip, so the image is byte-identical for
-//! any thread count and any strip height.
+//! hands it to a fresh [`FramePipeline`], which sets every triangle up once
+//! into binned core frames (see [`crate::pipeline`]: one frame per setup
+//! thread from 20,000 triangles up, storage sized from the triangle count
+//! and grown only on `Error::StorageFull`), then draws strips of
+//! `strip_rows` rows on `std::thread::scope` workers that take them from one
+//! shared queue, so more strips than threads balance the load; each worker
+//! owns its `&mut` rows and clears them before drawing. The triangle-id
+//! image, if asked for, is drawn from the same set-up frames. The core draws
+//! triangles in submission order in every strip, so the image is
+//! byte-identical for any thread count and any strip height.
 
 use crate::cliptris::ClipTri;
+use crate::pipeline::{draw_layers, DepthFormat, FramePipeline, Layer};
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::{
-    Bins, BoundingSphere, ClipVertex, Config, CullMode, DepthBuffer, Error, Frame, Mat4, Mesh,
-    MeshColors, NoDepth, Pixel, ProcessedVertex, SetupTriangle, Stats, TriangleId, Vec3, Vec4,
+    BoundingSphere, Config, CullMode, Mat4, Mesh, MeshColors, Pixel, Stats, TriangleId, Vec3,
 };
-use std::sync::Mutex;
 use std::time::Instant;
 
 /// The background colour of rendered images.
@@ -277,306 +278,38 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
     }
 }
 
-/// One piece of a scene's triangle sequence: triangles `range` of object
-/// `object`, or clip-space triangles `range`.
-#[derive(Clone, Debug)]
-enum Piece {
-    Object(usize, std::ops::Range<usize>),
-    ClipTris(std::ops::Range<usize>),
-}
-
-/// Splits the scene's triangle sequence into `parts` contiguous chunks of
-/// about equal size, in drawing order.
-fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
-    let total = scene.triangle_count().max(1);
-    let per = total.div_ceil(parts.max(1)).max(1);
-    let mut chunks: Vec<Vec<Piece>> = vec![Vec::new()];
-    let mut room = per;
-    let mut push = |len: usize, make: &dyn Fn(std::ops::Range<usize>) -> Piece| {
-        let mut start = 0;
-        while start < len {
-            if room == 0 {
-                chunks.push(Vec::new());
-                room = per;
-            }
-            let take = room.min(len - start);
-            if let Some(c) = chunks.last_mut() {
-                c.push(make(start..start + take));
-            }
-            start += take;
-            room -= take;
-        }
-    };
-    for (i, o) in scene.objects.iter().enumerate() {
-        push(o.indices.len(), &|r| Piece::Object(i, r));
-    }
-    push(scene.clip_tris.len(), &|r| Piece::ClipTris(r));
-    chunks
-}
-
-/// The first triangle id of each object, and of the clip-space triangles.
-fn first_ids(scene: &Scene) -> (Vec<u32>, u32) {
-    let mut ids = Vec::with_capacity(scene.objects.len());
-    let mut id = 0u32;
-    for o in &scene.objects {
-        ids.push(id);
-        id = id.wrapping_add(o.indices.len() as u32);
-    }
-    (ids, id)
-}
-
-/// Pushes the triangles of `pieces` into `frame`. Objects use the vertex
-/// cache `caches[i]` (already processed), or are skipped whole when their
-/// bounding sphere is outside the frustum.
-fn fill<const S: u32>(
-    frame: &mut Frame<'_, S>,
-    scene: &Scene,
-    pieces: &[Piece],
-    caches: &[Option<Vec<ProcessedVertex>>],
-) -> Result<(), Error> {
-    let (ids, clip_first) = first_ids(scene);
-    for piece in pieces {
-        match piece {
-            Piece::Object(i, r) => {
-                let o = &scene.objects[*i];
-                let mut mesh = o.mesh();
-                mesh.indices = &o.indices[r.clone()];
-                if let ObjectColors::PerTriangle(c) = &o.colors {
-                    mesh.colors = MeshColors::PerTriangle(&c[r.clone()]);
-                }
-                let id = ids[*i].wrapping_add(r.start as u32);
-                match &caches[*i] {
-                    Some(cache) => frame.draw_mesh_processed(&mesh, id, cache)?,
-                    // Culled by its bounding sphere: counted, nothing else.
-                    None => frame.draw_mesh(&mesh, &o.mvp, id)?,
-                }
-            }
-            Piece::ClipTris(r) => {
-                for (k, t) in scene.clip_tris[r.clone()].iter().enumerate() {
-                    let [cr, cg, cb] = t.color.unwrap_or([255, 255, 255]);
-                    let color = [cr as f32, cg as f32, cb as f32];
-                    let v = t.v.map(|p| ClipVertex {
-                        pos: Vec4::from_array(p),
-                        color,
-                    });
-                    let id = clip_first.wrapping_add((r.start + k) as u32);
-                    frame.push_triangle(v, id)?;
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Runs the vertex stage of every visible object, `threads` workers per
-/// object; `None` for an object outside the frustum.
-fn process_objects<const S: u32>(
-    scene: &Scene,
-    config: Config,
-    threads: usize,
-) -> Result<Vec<Option<Vec<ProcessedVertex>>>, String> {
-    let probe = Frame::<S>::new(config, &mut []).map_err(|e| e.to_string())?;
-    let mut caches = Vec::with_capacity(scene.objects.len());
-    for o in &scene.objects {
-        if o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
-            caches.push(None);
-            continue;
-        }
-        let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
-        let chunk = o.positions.len().div_ceil(threads.max(1)).max(4096);
-        std::thread::scope(|s| {
-            for (p, c) in o.positions.chunks(chunk).zip(cache.chunks_mut(chunk)) {
-                let probe = &probe;
-                s.spawn(move || probe.process_vertices(&o.mvp, p, c));
-            }
-        });
-        caches.push(Some(cache));
-    }
-    Ok(caches)
-}
-
-/// Builds one frame per chunk of the scene (in parallel), each in its own
-/// storage; drawn in order they are the scene.
-fn build_frames<'s, const S: u32>(
-    scene: &Scene,
-    config: Config,
-    chunks: &[Vec<Piece>],
-    caches: &[Option<Vec<ProcessedVertex>>],
-    storages: &'s mut [Vec<SetupTriangle>],
-) -> Result<Vec<Frame<'s, S>>, String> {
-    std::thread::scope(|s| {
-        let handles: Vec<_> = storages
-            .iter_mut()
-            .zip(chunks)
-            .map(|(storage, pieces)| {
-                s.spawn(move || -> Result<Frame<'s, S>, String> {
-                    // Grow the storage until the chunk fits (clipping can
-                    // turn one triangle into several; the first guess
-                    // almost always suffices).
-                    loop {
-                        let needed = {
-                            let mut f =
-                                Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
-                            match fill(&mut f, scene, pieces, caches) {
-                                Ok(()) => 0,
-                                Err(Error::StorageFull { needed, .. }) => needed,
-                                Err(e) => return Err(e.to_string()),
-                            }
-                        };
-                        if needed == 0 {
-                            break;
-                        }
-                        let grow = needed.max(storage.len() / 2);
-                        storage.resize(storage.len() + grow, SetupTriangle::EMPTY);
-                    }
-                    let mut f = Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
-                    fill(&mut f, scene, pieces, caches).map_err(|e| e.to_string())?;
-                    Ok(f)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| Err("setup worker failed".into()))
-            })
-            .collect()
-    })
-}
-
 fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
-    let threads = opts.threads.max(1);
-    let t0 = Instant::now();
-    // Set up in parallel only where there is enough work to share.
-    let parts = if scene.triangle_count() >= 20_000 {
-        threads
-    } else {
-        1
-    };
-    let caches = process_objects::<S>(scene, config, threads)?;
-    let chunks = partition(scene, parts);
-    let mut storages: Vec<Vec<SetupTriangle>> = chunks
-        .iter()
-        .map(|pieces| {
-            let n: usize = pieces
-                .iter()
-                .map(|p| match p {
-                    Piece::Object(_, r) | Piece::ClipTris(r) => r.len(),
-                })
-                .sum();
-            vec![SetupTriangle::EMPTY; n + n / 8 + 64]
-        })
-        .collect();
-    let frames = build_frames::<S>(scene, config, &chunks, &caches, &mut storages)?;
-    let mut stats = Stats::default();
-    for f in &frames {
-        let s = f.stats();
-        stats.submitted += s.submitted;
-        stats.culled_object += s.culled_object;
-        stats.culled_frustum += s.culled_frustum;
-        stats.culled_backface += s.culled_backface;
-        stats.culled_degenerate += s.culled_degenerate;
-        stats.rejected_nonfinite += s.rejected_nonfinite;
-        stats.rejected_index += s.rejected_index;
-        stats.clipped += s.clipped;
-        stats.stored += s.stored;
-    }
-    // Bin every frame's triangles by strip.
-    let strip_rows = opts.strip_rows.max(1);
-    let strips = h.div_ceil(strip_rows) as usize;
-    let mut bin_store: Vec<(Vec<u32>, Vec<u32>)> = frames
-        .iter()
-        .map(|f| {
-            (
-                vec![0u32; strips + 1],
-                vec![0u32; f.bin_entries(strip_rows)],
-            )
-        })
-        .collect();
-    let bins = frames
-        .iter()
-        .zip(bin_store.iter_mut())
-        .map(|(f, (o, i))| f.bin(strip_rows, o, i))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
-    let layers: Vec<(&Frame<'_, S>, &Bins<'_>)> = frames.iter().zip(bins.iter()).collect();
-    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
-
+    let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
     let len = w as usize * h as usize;
-    let mut color = vec![BACKGROUND; len];
-    let t1 = Instant::now();
-    let (depth, pixels_written) = match opts.depth {
-        DepthKind::U16 => {
-            let mut d = vec![u16::MAX; len];
-            let px = render_strips(
-                &layers,
-                &mut color,
-                Some(&mut d[..]),
-                BACKGROUND,
-                u16::MAX,
-                opts,
-            )?;
-            (DepthImage::U16(d), px)
-        }
-        DepthKind::U32 => {
-            let mut d = vec![u32::MAX; len];
-            let px = render_strips(
-                &layers,
-                &mut color,
-                Some(&mut d[..]),
-                BACKGROUND,
-                u32::MAX,
-                opts,
-            )?;
-            (DepthImage::U32(d), px)
-        }
-        DepthKind::None => {
-            let px = render_strips::<S, _, u32>(&layers, &mut color, None, BACKGROUND, 0, opts)?;
-            (DepthImage::None, px)
-        }
-    };
-    let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
-
-    let t2 = Instant::now();
-    let ids = if opts.ids {
-        let mut ids = vec![TriangleId(0); len];
-        match opts.depth {
-            DepthKind::U16 => {
-                let mut d = vec![u16::MAX; len];
-                render_strips(
-                    &layers,
-                    &mut ids,
-                    Some(&mut d[..]),
-                    TriangleId(0),
-                    u16::MAX,
-                    opts,
-                )?
-            }
-            DepthKind::U32 => {
-                let mut d = vec![u32::MAX; len];
-                render_strips(
-                    &layers,
-                    &mut ids,
-                    Some(&mut d[..]),
-                    TriangleId(0),
-                    u32::MAX,
-                    opts,
-                )?
-            }
-            DepthKind::None => {
-                render_strips::<S, _, u32>(&layers, &mut ids, None, TriangleId(0), 0, opts)?
-            }
-        };
-        Some(ids.into_iter().map(|t| t.0).collect())
-    } else {
-        None
-    };
-    let ids_ms = t2.elapsed().as_secs_f64() * 1e3;
-
+    let t0 = Instant::now();
+    let mut pipe = FramePipeline::<S>::new(config, threads, rows);
+    let ((color, depth, pixels_written, ids, timings), setup) =
+        pipe.with_layers(scene, |layers| {
+            let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+            let mut color = vec![BACKGROUND; len];
+            let t1 = Instant::now();
+            let (depth, px) =
+                draw_image(layers, &mut color, opts.depth, BACKGROUND, rows, threads)?;
+            let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
+            let t2 = Instant::now();
+            let ids = if opts.ids {
+                let mut ids = vec![TriangleId(0); len];
+                draw_image(layers, &mut ids, opts.depth, TriangleId(0), rows, threads)?;
+                Some(ids.into_iter().map(|t| t.0).collect())
+            } else {
+                None
+            };
+            let ids_ms = t2.elapsed().as_secs_f64() * 1e3;
+            let timings = Timings {
+                setup_ms,
+                raster_ms,
+                ids_ms,
+            };
+            Ok((color, depth, px, ids, timings))
+        })?;
     let rgb = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
     Ok(Rendered {
         width: w,
@@ -584,90 +317,41 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
         rgb,
         ids,
         depth,
-        stats,
+        stats: setup.stats,
         pixels_written,
-        timings: Timings {
-            setup_ms,
-            raster_ms,
-            ids_ms,
-        },
+        timings,
     })
 }
 
-/// One strip of work: its index and its rows of colour and depth.
-type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
-
-/// Clears and renders every strip of `color` (and `depth`) on
-/// `opts.threads` workers, drawing the binned frames `layers` in order.
-/// Returns the pixels written.
-fn render_strips<const S: u32, C, T>(
-    layers: &[(&Frame<'_, S>, &Bins<'_>)],
+/// Draws the binned frames `layers` into `color` with a new depth buffer
+/// `kind`, every strip cleared to `clear` first. Returns the depth buffer
+/// after drawing and the pixels written.
+fn draw_image<const S: u32, C: Pixel + Send + Sync>(
+    layers: &[Layer<'_, '_, S>],
     color: &mut [C],
-    depth: Option<&mut [T]>,
-    clear_color: C,
-    clear_depth: T,
-    opts: &RenderOptions,
-) -> Result<u64, String>
-where
-    C: Pixel + Send + Sync,
-    T: Copy + Send + Sync,
-    [T]: DepthBuffer,
-{
-    let width = opts.width as usize;
-    let rows = opts.strip_rows.max(1) as usize;
-    let chunk = width * rows;
-    let mut work: Vec<Work<'_, C, T>> = Vec::new();
-    match depth {
-        Some(d) => {
-            for (i, (c, d)) in color.chunks_mut(chunk).zip(d.chunks_mut(chunk)).enumerate() {
-                work.push((i as u32, c, Some(d)));
-            }
+    kind: DepthKind,
+    clear: C,
+    rows: u32,
+    threads: usize,
+) -> Result<(DepthImage, u64), String> {
+    let len = color.len();
+    let (depth, px) = match kind {
+        DepthKind::U16 => {
+            let mut d = vec![u16::CLEAR; len];
+            let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
+            (DepthImage::U16(d), px)
         }
-        None => {
-            for (i, c) in color.chunks_mut(chunk).enumerate() {
-                work.push((i as u32, c, None));
-            }
+        DepthKind::U32 => {
+            let mut d = vec![u32::CLEAR; len];
+            let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
+            (DepthImage::U32(d), px)
         }
-    }
-    let queue = Mutex::new(work.into_iter());
-    let threads = opts.threads.max(1);
-    let results: Vec<Result<u64, Error>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| -> Result<u64, Error> {
-                    let mut written = 0u64;
-                    loop {
-                        let item = match queue.lock() {
-                            Ok(mut q) => q.next(),
-                            Err(poisoned) => poisoned.into_inner().next(),
-                        };
-                        let Some((strip, c, mut d)) = item else { break };
-                        c.fill(clear_color);
-                        if let Some(d) = d.as_deref_mut() {
-                            d.fill(clear_depth);
-                        }
-                        for (frame, bins) in layers {
-                            written += match d.as_deref_mut() {
-                                Some(d) => frame.render_strip(bins, strip, c, d)?,
-                                None => frame.render_strip(bins, strip, c, &mut NoDepth)?,
-                            }
-                            .pixels_written;
-                        }
-                    }
-                    Ok(written)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or(Ok(0)))
-            .collect()
-    });
-    let mut total = 0;
-    for r in results {
-        total += r.map_err(|e| e.to_string())?;
-    }
-    Ok(total)
+        DepthKind::None => {
+            let px = draw_layers::<S, C, u32>(layers, color, None, rows, threads, Some(clear));
+            (DepthImage::None, px)
+        }
+    };
+    Ok((depth, px.map_err(|e| e.to_string())?))
 }
 
 #[cfg(test)]

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Smoke test of `microraster bench`: every built-in scene once at its real
+# size with a few frames, the peers, thread lists and the memory floor.
+# Checks that each run prints valid JSON with positive times and that
+# output is identical across thread counts; it does not judge speed.
+# Exits non-zero on the first failure. About a minute once the release
+# binary is built (building it first takes a minute or two more).
+# Set BENCH_SMOKE_CRITERION=1 to also compile the criterion benches.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo build --release -q -p microraster-host
+bin=target/release/microraster
+out=target/ci/bench
+mkdir -p "$out"
+
+# check FILE EXPR...: each Python expression over the JSON object `d` must hold.
+check() {
+  local file=$1
+  shift
+  python3 - "$file" "$@" <<'PY'
+import json, math, sys
+path, *exprs = sys.argv[1:]
+d = json.load(open(path))
+def pos(x):
+    return isinstance(x, (int, float)) and math.isfinite(x) and x > 0
+for e in exprs:
+    if not eval(e, {"d": d, "pos": pos}):
+        sys.exit(f"{path}: check failed: {e}")
+print(f"{path}: {d['scene']} {d['size']} threads {d['threads']}: "
+      f"median {d['median_ms']:.3f} ms, min {d['min_ms']:.3f} ms")
+PY
+}
+
+run() {
+  local name=$1
+  shift
+  echo "+ microraster bench $*"
+  "$bin" bench "$@" --compact >"$out/$name.json"
+}
+
+common='pos(d["median_ms"]) and pos(d["min_ms"]) and pos(d["triangles_per_s"])'
+
+run cubes --scene cubes --frames 5 --warmup 1 --threads 1,2
+check "$out/cubes.json" "$common" 'd["scaling"]["identical_output"] is True' \
+  'pos(d["split"]["table"]["traversal_ms"])'
+
+run sphere --scene sphere --frames 10 --warmup 2 --peers
+check "$out/sphere.json" "$common" 'd["triangles"] == 20000' 'd["threads"] == 1' \
+  'd["depth"] == "u16"' 'pos(d["peers"]["euc_over_microraster"])' \
+  'pos(d["peers"]["embedded_graphics_2d"]["eg_over_microraster"])' \
+  'd["peers"]["euc"]["covered_pixels"] == d["peers"]["microraster"]["covered_pixels"]'
+
+run bunny --scene bunny --frames 3 --warmup 1 --threads 1,2 --peers
+check "$out/bunny.json" "$common" 'd["triangles"] == 69451' \
+  'd["scaling"]["identical_output"] is True' 'pos(d["peers"]["euc_over_microraster"])' \
+  'pos(d["split"]["table"]["cull_clip_setup_ms"])'
+
+run bunny-subdiv --scene bunny-subdiv --frames 1 --warmup 0 --no-split
+check "$out/bunny-subdiv.json" "$common" 'd["triangles"] == 1111216'
+
+run quad --scene quad --frames 5 --warmup 1
+check "$out/quad.json" "$common" 'd["pixels_written"] == 1920 * 1080' \
+  'pos(d["floor"]["floor_ms"])' 'pos(d["floor"]["frame_over_floor"])'
+
+if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
+  cargo bench -q -p microraster-host --bench core --no-run
+fi
+
+echo "bench smoke: all runs passed"

@@ -1,0 +1,719 @@
+//! The frame pipeline shared by [`crate::render`] and [`crate::bench`]: a
+//! [`Scene`] set up into binned core frames, then drawn strip by strip.
+//!
+//! Design note: [`FramePipeline::with_layers`] runs three stages. The vertex
+//! stage processes every object inside the frustum once, in parallel chunks
+//! of at least [`VERTEX_CHUNK_MIN`] vertices. The triangle stage splits the
+//! scene's triangle sequence into up to `threads` contiguous [`Piece`]s
+//! ([`partition`]; one chunk below [`PARALLEL_SETUP_MIN_TRIANGLES`]) and
+//! [`fill`]s each chunk into its own [`Frame`] and setup storage. Binning then
+//! sorts each frame's triangles by strip. Every frame is set up exactly once:
+//! storage is sized from the triangle count, and only when a chunk reports
+//! [`Error::StorageFull`] (clipping made more triangles than the guess) are
+//! the full storages grown and the chunks built again. The pipeline keeps its
+//! vertex caches, storages and bins from one call to the next, so a benchmark
+//! loop stops allocating after its first frame; `render::render` uses a fresh
+//! one per image. [`draw_layers`] clears and draws strips on `threads`
+//! workers that take them from one shared queue (inline for one thread).
+//! Every strip draws the frames in order and the core draws triangles in
+//! submission order, so the image is byte-identical for any thread count and
+//! any strip height.
+
+use crate::render::{ObjectColors, Scene};
+use microraster::{
+    Bins, ClipVertex, Config, Error, Frame, MeshColors, NoDepth, Pixel, ProcessedVertex,
+    SetupTriangle, Stats, Vec4,
+};
+use std::ops::Range;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Triangle counts at and above which the triangle stage is split over the
+/// threads.
+pub const PARALLEL_SETUP_MIN_TRIANGLES: usize = 20_000;
+
+/// Vertices per vertex-stage worker, at least.
+pub const VERTEX_CHUNK_MIN: usize = 4096;
+
+/// One piece of a scene's triangle sequence: triangles `range` of object
+/// `object`, or clip-space triangles `range`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Piece {
+    /// Triangles of `scene.objects[object]`.
+    Object(usize, Range<usize>),
+    /// Triangles of `scene.clip_tris`.
+    ClipTris(Range<usize>),
+}
+
+impl Piece {
+    /// The number of triangles.
+    pub fn len(&self) -> usize {
+        match self {
+            Piece::Object(_, r) | Piece::ClipTris(r) => r.len(),
+        }
+    }
+
+    /// Whether the piece has no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Splits the scene's triangle sequence into at most `parts` contiguous
+/// chunks of about equal size, in drawing order.
+pub fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
+    let total = scene.triangle_count().max(1);
+    let per = total.div_ceil(parts.max(1)).max(1);
+    let mut chunks: Vec<Vec<Piece>> = vec![Vec::new()];
+    let mut room = per;
+    let mut push = |len: usize, make: &dyn Fn(Range<usize>) -> Piece| {
+        let mut start = 0;
+        while start < len {
+            if room == 0 {
+                chunks.push(Vec::new());
+                room = per;
+            }
+            let take = room.min(len - start);
+            if let Some(c) = chunks.last_mut() {
+                c.push(make(start..start + take));
+            }
+            start += take;
+            room -= take;
+        }
+    };
+    for (i, o) in scene.objects.iter().enumerate() {
+        push(o.indices.len(), &|r| Piece::Object(i, r));
+    }
+    push(scene.clip_tris.len(), &|r| Piece::ClipTris(r));
+    chunks
+}
+
+/// Pushes the triangles of `pieces` into `frame`: objects through their
+/// processed vertices `caches[object]` (`None`: outside the frustum, only
+/// counted, by `draw_mesh`), clip-space triangles one by one. Triangle ids
+/// count from 0 over the whole scene, objects first.
+pub fn fill<const S: u32>(
+    frame: &mut Frame<'_, S>,
+    scene: &Scene,
+    pieces: &[Piece],
+    caches: &[Option<&[ProcessedVertex]>],
+) -> Result<(), Error> {
+    let mut first_ids = Vec::with_capacity(scene.objects.len());
+    let mut id = 0u32;
+    for o in &scene.objects {
+        first_ids.push(id);
+        id = id.wrapping_add(o.indices.len() as u32);
+    }
+    let clip_first = id;
+    for piece in pieces {
+        match piece {
+            Piece::Object(i, r) => {
+                let o = &scene.objects[*i];
+                let mut mesh = o.mesh();
+                mesh.indices = &o.indices[r.clone()];
+                if let ObjectColors::PerTriangle(c) = &o.colors {
+                    mesh.colors = MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
+                }
+                let id = first_ids[*i].wrapping_add(r.start as u32);
+                match caches.get(*i).copied().flatten() {
+                    Some(cache) => frame.draw_mesh_processed(&mesh, id, cache)?,
+                    None => frame.draw_mesh(&mesh, &o.mvp, id)?,
+                }
+            }
+            Piece::ClipTris(r) => {
+                for (k, t) in scene.clip_tris[r.clone()].iter().enumerate() {
+                    let [cr, cg, cb] = t.color.unwrap_or([255, 255, 255]);
+                    let color = [cr as f32, cg as f32, cb as f32];
+                    let v = t.v.map(|p| ClipVertex {
+                        pos: Vec4::from_array(p),
+                        color,
+                    });
+                    frame.push_triangle(v, clip_first.wrapping_add((r.start + k) as u32))?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Adds the counters `o` to `a`.
+pub fn add_stats(a: &mut Stats, o: &Stats) {
+    a.submitted += o.submitted;
+    a.culled_object += o.culled_object;
+    a.culled_frustum += o.culled_frustum;
+    a.culled_backface += o.culled_backface;
+    a.culled_degenerate += o.culled_degenerate;
+    a.rejected_nonfinite += o.rejected_nonfinite;
+    a.rejected_index += o.rejected_index;
+    a.clipped += o.clipped;
+    a.stored += o.stored;
+    a.outside_strip += o.outside_strip;
+}
+
+// ---------------------------------------------------------------------------
+// Strips.
+
+/// A depth format to draw strips with.
+pub trait DepthFormat: Copy + Send + Sync + 'static {
+    /// The cleared (farthest) value.
+    const CLEAR: Self;
+    /// `frame.render_strip` with this depth slice; the pixels written.
+    fn render_strip<const S: u32, C: Pixel>(
+        frame: &Frame<'_, S>,
+        bins: &Bins<'_>,
+        strip: u32,
+        color: &mut [C],
+        depth: &mut [Self],
+    ) -> Result<u64, Error>;
+}
+
+macro_rules! depth_format {
+    ($t:ty) => {
+        impl DepthFormat for $t {
+            const CLEAR: Self = <$t>::MAX;
+            fn render_strip<const S: u32, C: Pixel>(
+                frame: &Frame<'_, S>,
+                bins: &Bins<'_>,
+                strip: u32,
+                color: &mut [C],
+                depth: &mut [$t],
+            ) -> Result<u64, Error> {
+                Ok(frame
+                    .render_strip(bins, strip, color, depth)?
+                    .pixels_written)
+            }
+        }
+    };
+}
+depth_format!(u16);
+depth_format!(u32);
+
+/// One strip: its first row and its rows of colour and depth.
+type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
+
+/// Calls `f(y0, colour rows, depth rows)` for every strip of `rows` rows of
+/// `width` pixels on `threads` workers taking strips from a shared queue
+/// (inline for one thread) and sums what it returns.
+pub fn for_each_strip<C, T, F>(
+    color: &mut [C],
+    depth: Option<&mut [T]>,
+    width: usize,
+    rows: usize,
+    threads: usize,
+    f: F,
+) -> Result<u64, Error>
+where
+    C: Send,
+    T: Send,
+    F: Fn(u32, &mut [C], Option<&mut [T]>) -> Result<u64, Error> + Sync,
+{
+    let rows = rows.max(1);
+    let chunk = width * rows;
+    let mut work: Vec<Work<'_, C, T>> = Vec::new();
+    match depth {
+        Some(d) => {
+            for (i, (c, d)) in color.chunks_mut(chunk).zip(d.chunks_mut(chunk)).enumerate() {
+                work.push(((i * rows) as u32, c, Some(d)));
+            }
+        }
+        None => {
+            for (i, c) in color.chunks_mut(chunk).enumerate() {
+                work.push(((i * rows) as u32, c, None));
+            }
+        }
+    }
+    if threads <= 1 {
+        let mut total = 0;
+        for (y0, c, d) in work {
+            total += f(y0, c, d)?;
+        }
+        return Ok(total);
+    }
+    let queue = Mutex::new(work.into_iter());
+    let results: Vec<Result<u64, Error>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| -> Result<u64, Error> {
+                    let mut total = 0;
+                    loop {
+                        let item = match queue.lock() {
+                            Ok(mut q) => q.next(),
+                            Err(poisoned) => poisoned.into_inner().next(),
+                        };
+                        let Some((y0, c, d)) = item else { break };
+                        total += f(y0, c, d)?;
+                    }
+                    Ok(total)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or(Ok(0)))
+            .collect()
+    });
+    let mut total = 0;
+    for r in results {
+        total += r?;
+    }
+    Ok(total)
+}
+
+/// A set-up, binned frame: the part of the scene one setup worker built.
+pub type Layer<'a, 'f, const S: u32> = (&'a Frame<'f, S>, &'a Bins<'a>);
+
+/// Draws every strip of the binned frames `layers` (in order, binned into
+/// strips of `rows` rows) on `threads` workers, clearing each strip first
+/// (colour to `clear`, depth to [`DepthFormat::CLEAR`]) if `clear` is given.
+/// Returns the pixels written.
+pub fn draw_layers<const S: u32, C: Pixel + Send + Sync, T: DepthFormat>(
+    layers: &[Layer<'_, '_, S>],
+    color: &mut [C],
+    depth: Option<&mut [T]>,
+    rows: u32,
+    threads: usize,
+    clear: Option<C>,
+) -> Result<u64, Error> {
+    let Some((first, _)) = layers.first() else {
+        return Ok(0);
+    };
+    let width = first.config().width as usize;
+    let rows = rows.max(1);
+    for_each_strip(
+        color,
+        depth,
+        width,
+        rows as usize,
+        threads,
+        |y0, c, mut d| {
+            let strip = y0 / rows;
+            if let Some(v) = clear {
+                c.fill(v);
+                if let Some(d) = d.as_deref_mut() {
+                    d.fill(T::CLEAR);
+                }
+            }
+            let mut written = 0;
+            for (frame, bins) in layers {
+                written += match d.as_deref_mut() {
+                    Some(d) => T::render_strip(frame, bins, strip, c, d)?,
+                    None => {
+                        frame
+                            .render_strip(bins, strip, c, &mut NoDepth)?
+                            .pixels_written
+                    }
+                };
+            }
+            Ok(written)
+        },
+    )
+}
+
+// ---------------------------------------------------------------------------
+// The pipeline.
+
+/// Times of the setup stages of one frame, in milliseconds, and its
+/// counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SetupTimes {
+    /// Vertex stage: transform, outcode, snap (every vertex once).
+    pub vertex_ms: f64,
+    /// Triangle stage: cull, clip, set up and store.
+    pub triangles_ms: f64,
+    /// Binning by strip.
+    pub binning_ms: f64,
+    /// The core's counters, summed over the setup workers' frames.
+    pub stats: Stats,
+}
+
+impl SetupTimes {
+    /// Vertex + triangle + binning stages.
+    pub fn total_ms(&self) -> f64 {
+        self.vertex_ms + self.triangles_ms + self.binning_ms
+    }
+}
+
+/// Frames of one scene set up, binned and drawn with every buffer kept from
+/// one frame to the next (see the module documentation): the vertex stage of
+/// each visible object in parallel chunks, the triangle stage in `threads`
+/// contiguous chunks of the scene (one below
+/// [`PARALLEL_SETUP_MIN_TRIANGLES`] triangles), each into its own frame and
+/// setup storage, each frame binned by strip, and the strips drawn on
+/// `threads` workers, every strip drawing the frames in order.
+#[derive(Debug)]
+pub struct FramePipeline<const S: u32> {
+    config: Config,
+    threads: usize,
+    strip_rows: u32,
+    caches: Vec<Vec<ProcessedVertex>>,
+    storages: Vec<Vec<SetupTriangle>>,
+    bins: Vec<(Vec<u32>, Vec<u32>)>,
+}
+
+/// One setup worker's frame: `Ok(Err(needed))` when its storage is full.
+type Built<'s, const S: u32> = Result<Result<Frame<'s, S>, usize>, String>;
+
+fn build_chunk<'s, const S: u32>(
+    config: Config,
+    storage: &'s mut [SetupTriangle],
+    scene: &Scene,
+    pieces: &[Piece],
+    caches: &[Option<&[ProcessedVertex]>],
+) -> Built<'s, S> {
+    let mut f = Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
+    match fill(&mut f, scene, pieces, caches) {
+        Ok(()) => Ok(Ok(f)),
+        Err(Error::StorageFull { needed, .. }) => Ok(Err(needed)),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Builds one frame per chunk of the scene, each in its own storage, in
+/// parallel when there is more than one chunk.
+fn build_chunks<'s, const S: u32>(
+    config: Config,
+    storages: &'s mut [Vec<SetupTriangle>],
+    scene: &Scene,
+    chunks: &[Vec<Piece>],
+    caches: &[Option<&[ProcessedVertex]>],
+) -> Vec<Built<'s, S>> {
+    let build = |storage, pieces| build_chunk::<S>(config, storage, scene, pieces, caches);
+    if chunks.len() == 1 {
+        return storages
+            .iter_mut()
+            .zip(chunks)
+            .map(|(s, p)| build(s, p))
+            .collect();
+    }
+    std::thread::scope(|s| {
+        let handles: Vec<_> = storages
+            .iter_mut()
+            .zip(chunks)
+            .map(|(st, p)| s.spawn(move || build(st, p)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err("setup worker failed".into()))
+            })
+            .collect()
+    })
+}
+
+/// Runs the vertex stage of every object of `scene` inside the frustum into
+/// `caches` (grown as needed), `threads` workers per object. Returns each
+/// object's processed vertices, `None` for one outside the frustum.
+fn vertex_stage<'c, const S: u32>(
+    config: Config,
+    threads: usize,
+    scene: &Scene,
+    caches: &'c mut Vec<Vec<ProcessedVertex>>,
+) -> Result<Vec<Option<&'c [ProcessedVertex]>>, String> {
+    let probe = Frame::<S>::new(config, &mut []).map_err(|e| e.to_string())?;
+    if caches.len() < scene.objects.len() {
+        caches.resize_with(scene.objects.len(), Vec::new);
+    }
+    let mut out = Vec::with_capacity(scene.objects.len());
+    for (o, cache) in scene.objects.iter().zip(caches.iter_mut()) {
+        if o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
+            out.push(None);
+            continue;
+        }
+        if cache.len() < o.positions.len() {
+            cache.resize(o.positions.len(), ProcessedVertex::EMPTY);
+        }
+        let cache = &mut cache[..o.positions.len()];
+        let chunk = o.positions.len().div_ceil(threads).max(VERTEX_CHUNK_MIN);
+        if threads == 1 || o.positions.len() <= chunk {
+            probe.process_vertices(&o.mvp, &o.positions, cache);
+        } else {
+            let probe = &probe;
+            std::thread::scope(|s| {
+                for (p, c) in o.positions.chunks(chunk).zip(cache.chunks_mut(chunk)) {
+                    s.spawn(move || probe.process_vertices(&o.mvp, p, c));
+                }
+            });
+        }
+        out.push(Some(&*cache));
+    }
+    Ok(out)
+}
+
+impl<const S: u32> FramePipeline<S> {
+    /// A pipeline for frames of `config`, on `threads` threads, binned into
+    /// strips of `strip_rows` rows.
+    pub fn new(config: Config, threads: usize, strip_rows: u32) -> Self {
+        FramePipeline {
+            config,
+            threads: threads.max(1),
+            strip_rows: strip_rows.max(1),
+            caches: Vec::new(),
+            storages: Vec::new(),
+            bins: Vec::new(),
+        }
+    }
+
+    /// The frame settings.
+    pub fn config(&self) -> Config {
+        self.config
+    }
+
+    /// The worker threads (at least 1).
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// The rows per strip (at least 1).
+    pub fn strip_rows(&self) -> u32 {
+        self.strip_rows
+    }
+
+    /// Sets `scene` up (vertex stage, triangle stage, binning) and hands
+    /// the binned frames to `then`.
+    pub fn with_layers<R>(
+        &mut self,
+        scene: &Scene,
+        then: impl FnOnce(&[Layer<'_, '_, S>]) -> Result<R, String>,
+    ) -> Result<(R, SetupTimes), String> {
+        let FramePipeline {
+            config,
+            threads,
+            strip_rows,
+            caches,
+            storages,
+            bins,
+        } = self;
+        let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
+        let t0 = Instant::now();
+        let caches = vertex_stage::<S>(config, threads, scene, caches)?;
+        let caches = &caches[..];
+        let vertex_ms = ms(t0);
+
+        // Triangle stage, in chunks of the scene.
+        let parts = if scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES {
+            threads
+        } else {
+            1
+        };
+        let chunks = partition(scene, parts);
+        storages.resize_with(chunks.len(), Vec::new);
+        for (storage, pieces) in storages.iter_mut().zip(&chunks) {
+            let n: usize = pieces.iter().map(Piece::len).sum();
+            if storage.len() < n + n / 8 + 64 {
+                storage.resize(n + n / 8 + 64, SetupTriangle::EMPTY);
+            }
+        }
+        // Every chunk is built once. A chunk whose storage was too small
+        // (clipping can turn one triangle into several; the first guess
+        // almost always suffices) has its storage grown, and then every
+        // chunk is built again: a failed frame cannot hand its storage back.
+        // The stage's time is that of the last (successful) attempt.
+        let (frames, triangles_ms) = loop {
+            let t1 = Instant::now();
+            let results = build_chunks::<S>(config, storages, scene, &chunks, caches);
+            let mut frames = Vec::with_capacity(results.len());
+            let mut grow = vec![0usize; results.len()];
+            for (i, r) in results.into_iter().enumerate() {
+                match r? {
+                    Ok(f) => frames.push(f),
+                    Err(needed) => grow[i] = needed,
+                }
+            }
+            if grow.iter().all(|&g| g == 0) {
+                break (frames, ms(t1));
+            }
+            drop(frames);
+            for (storage, g) in storages.iter_mut().zip(grow) {
+                if g > 0 {
+                    let by = g.max(storage.len() / 2);
+                    storage.resize(storage.len() + by, SetupTriangle::EMPTY);
+                }
+            }
+        };
+
+        // Binning.
+        let t2 = Instant::now();
+        let strips = config.height.div_ceil(strip_rows) as usize;
+        bins.resize_with(frames.len(), Default::default);
+        for (f, (offsets, items)) in frames.iter().zip(bins.iter_mut()) {
+            if offsets.len() < strips + 1 {
+                offsets.resize(strips + 1, 0);
+            }
+            let need = f.bin_entries(strip_rows);
+            if items.len() < need {
+                items.resize(need, 0);
+            }
+        }
+        let binned = frames
+            .iter()
+            .zip(bins.iter_mut())
+            .map(|(f, (o, i))| f.bin(strip_rows, o, i))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| e.to_string())?;
+        let layers: Vec<Layer<'_, '_, S>> = frames.iter().zip(binned.iter()).collect();
+        let binning_ms = ms(t2);
+        let mut stats = Stats::default();
+        for f in &frames {
+            add_stats(&mut stats, &f.stats());
+        }
+        let out = then(&layers)?;
+        Ok((
+            out,
+            SetupTimes {
+                vertex_ms,
+                triangles_ms,
+                binning_ms,
+                stats,
+            },
+        ))
+    }
+
+    /// Renders one frame of `scene` into `color` and `depth` (cleared
+    /// first, strip by strip). Returns the setup times, the raster time in
+    /// milliseconds and the pixels written.
+    pub fn render<C: Pixel + Send + Sync, T: DepthFormat>(
+        &mut self,
+        scene: &Scene,
+        color: &mut [C],
+        depth: Option<&mut [T]>,
+        clear: C,
+    ) -> Result<(SetupTimes, f64, u64), String> {
+        let (threads, rows) = (self.threads, self.strip_rows);
+        let ((raster_ms, px), setup) = self.with_layers(scene, |layers| {
+            let t = Instant::now();
+            let px = draw_layers(layers, color, depth, rows, threads, Some(clear))
+                .map_err(|e| e.to_string())?;
+            Ok((ms(t), px))
+        })?;
+        Ok((setup, raster_ms, px))
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cliptris::ClipTri;
+    use crate::render::{clip_tris_scene, cubes_scene};
+    use microraster::pixelcolor::{Rgb888, RgbColor};
+    use microraster::CullMode;
+
+    /// A triangle far beyond the guard band on three sides: clipped into
+    /// several, so a run of them overflows the first storage guess.
+    fn big() -> ClipTri {
+        ClipTri {
+            v: [
+                [-1e7, -1e6, 0.0, 1.0],
+                [1e7, -1e6, 0.0, 1.0],
+                [0.0, 1e7, 0.0, 1.0],
+            ],
+            color: Some([200, 100, 50]),
+        }
+    }
+
+    fn small(i: usize) -> ClipTri {
+        let x = (i % 90) as f32 / 50.0 - 1.0;
+        ClipTri {
+            v: [
+                [x, -0.5, 0.5, 1.0],
+                [x + 0.2, -0.5, 0.5, 1.0],
+                [x, 0.5, 0.5, 1.0],
+            ],
+            color: Some([(i % 251) as u8, 7, 9]),
+        }
+    }
+
+    fn config() -> Config {
+        let mut config = Config::new(64, 48);
+        config.cull = CullMode::None;
+        config
+    }
+
+    #[test]
+    fn partition_covers_the_scene_in_order() {
+        let mut scene = cubes_scene(32, 24);
+        scene.clip_tris = (0..10).map(small).collect();
+        for parts in [1, 2, 3, 7, 100] {
+            let chunks = partition(&scene, parts);
+            assert!(chunks.len() <= parts.max(1), "{parts}: {chunks:?}");
+            let flat: Vec<Piece> = chunks.into_iter().flatten().collect();
+            assert!(flat.iter().all(|p| !p.is_empty()));
+            assert_eq!(
+                flat.iter().map(Piece::len).sum::<usize>(),
+                scene.triangle_count()
+            );
+            // Contiguous: each piece starts where the last one of the same
+            // source ended.
+            let mut next = vec![0; scene.objects.len() + 1];
+            for p in &flat {
+                let (k, r) = match p {
+                    Piece::Object(i, r) => (*i, r),
+                    Piece::ClipTris(r) => (scene.objects.len(), r),
+                };
+                assert!(next[..k]
+                    .iter()
+                    .enumerate()
+                    .all(|(j, &n)| n == scene.objects[j].indices.len()));
+                assert_eq!(r.start, next[k]);
+                next[k] = r.end;
+            }
+        }
+    }
+
+    #[test]
+    fn setup_storage_grows_for_clipped_triangles() {
+        let scene = clip_tris_scene(vec![big(); 200]);
+        for threads in [1, 2] {
+            let mut pipe = FramePipeline::<8>::new(config(), threads, 16);
+            let mut color = vec![Rgb888::BLACK; 64 * 48];
+            let (setup, _, px) = pipe
+                .render::<Rgb888, u32>(&scene, &mut color, None, Rgb888::BLACK)
+                .unwrap();
+            assert_eq!(setup.stats.clipped, 200);
+            assert!(setup.stats.stored > 200 + 200 / 8 + 64, "{:?}", setup.stats);
+            assert_eq!(px, 200 * 64 * 48);
+            // Again, with the grown storage.
+            let (again, _, _) = pipe
+                .render::<Rgb888, u32>(&scene, &mut color, None, Rgb888::BLACK)
+                .unwrap();
+            assert_eq!(again.stats, setup.stats);
+        }
+    }
+
+    #[test]
+    fn one_full_chunk_among_several_gives_the_same_image() {
+        // Parallel setup; only the last chunk overflows its storage.
+        let mut tris: Vec<ClipTri> = (0..PARALLEL_SETUP_MIN_TRIANGLES).map(small).collect();
+        tris.extend(std::iter::repeat_n(big(), 4000));
+        tris.extend((0..50).map(small));
+        let scene = clip_tris_scene(tris);
+        let mut images = Vec::new();
+        for threads in [1, 2, 3] {
+            let mut pipe = FramePipeline::<8>::new(config(), threads, 5);
+            let mut color = vec![Rgb888::BLACK; 64 * 48];
+            let mut depth = vec![u32::CLEAR; 64 * 48];
+            let (setup, _, px) = pipe
+                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
+                .unwrap();
+            assert_eq!(setup.stats.clipped, 4000);
+            // With parallel setup the first chunk kept its first guess and
+            // the last one grew.
+            let guesses: Vec<usize> = partition(&scene, threads)
+                .iter()
+                .map(|c| c.iter().map(Piece::len).sum::<usize>())
+                .map(|n| n + n / 8 + 64)
+                .collect();
+            assert_eq!(pipe.storages.len(), threads);
+            if threads > 1 {
+                assert_eq!(pipe.storages[0].len(), guesses[0]);
+                assert!(pipe.storages[threads - 1].len() > guesses[threads - 1]);
+            }
+            images.push((color, depth, px, setup.stats));
+        }
+        assert!(images.windows(2).all(|w| w[0] == w[1]));
+    }
+}
