@@ -72,9 +72,9 @@ pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
 /// Rounds `v` to the nearest integer (halves up) and checks the result is
 /// within `±COORD_LIMIT`. `None` for NaN, infinities and out-of-range values.
 ///
-/// No float function is involved and no float rounding either: `floor(v)`
-/// comes from truncation (corrected by one for negative non-integers), the
-/// fraction `v - floor(v)` is exact in `f32`, and it decides the rounding.
+/// No float function is involved and no float rounding either: the
+/// integer part comes from truncation, the fraction `v - trunc(v)` is exact
+/// in `f32`, and it decides the rounding.
 /// (`floor(v + 0.5)` would not do: for odd `v` in `[2^23, 2^24)` the sum is
 /// a tie that `f32` rounds to even.)
 #[inline]
@@ -82,16 +82,14 @@ fn round_to_coord(v: f32) -> Option<i32> {
     if !(v.is_finite() && v.abs() <= COORD_LIMIT as f32) {
         return None;
     }
-    // |v| <= 2^28: `as` truncates exactly, and `i as f32` is exact (below
-    // 2^24 every integer is representable; above it `v` is an integer).
-    let mut i = v as i32;
-    if (i as f32) > v {
-        i -= 1;
-    }
-    if v - i as f32 >= 0.5 {
-        i += 1;
-    }
-    Some(i)
+    // |v| <= 2^28: `as` truncates exactly, `i as f32` is exact (below 2^24
+    // every integer is representable; above it `v` is an integer), and so
+    // is the fraction `f = v - i`, in (-1, 1). Halves go up.
+    let i = v as i32;
+    let f = v - i as f32;
+    let up = (f >= 0.5) as i32;
+    let down = (f < -0.5) as i32;
+    Some(i + up - down)
 }
 
 /// Snaps a clip-space position to window space at `S` subpixel bits.

@@ -1123,6 +1123,12 @@ pub(crate) fn triangles_processed<const S: u32>(
     mut skip: impl FnMut([Vec4; 3]) -> bool,
     mut sink: impl FnMut(SetupTriangle) -> bool,
 ) -> Result<(), usize> {
+    // Colour lists as long as the mesh need no check per triangle.
+    let colors_complete = match mesh.colors {
+        MeshColors::Uniform(_) => true,
+        MeshColors::PerTriangle(cs) => cs.len() >= mesh.indices.len(),
+        MeshColors::PerVertex(cs) => cs.len() >= cache.len(),
+    };
     for (i, idx) in mesh.indices.iter().enumerate() {
         let id = first_id.wrapping_add(i as u32);
         stats.submitted += 1;
@@ -1135,11 +1141,12 @@ pub(crate) fn triangles_processed<const S: u32>(
             continue;
         };
         // A missing colour counts as a bad index first, as in `draw_mesh`.
-        let colors_ok = match mesh.colors {
-            MeshColors::Uniform(_) => true,
-            MeshColors::PerTriangle(cs) => i < cs.len(),
-            MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
-        };
+        let colors_ok = colors_complete
+            || match mesh.colors {
+                MeshColors::Uniform(_) => true,
+                MeshColors::PerTriangle(cs) => i < cs.len(),
+                MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
+            };
         if !colors_ok {
             stats.rejected_index += 1;
             continue;

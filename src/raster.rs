@@ -370,19 +370,26 @@ fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
         let step = [edges[0].step_x, edges[1].step_x, edges[2].step_x];
         for _ in row_first..=row_last {
             let mut e = [edges[0].row, edges[1].row, edges[2].row];
-            // Interpolants start at the row's first covered pixel, where
-            // every edge value is non-negative (no cancellation).
-            let mut acc: Option<Acc<R>> = None;
-            for n in 0..=max_n as usize {
-                if (e[0] | e[1] | e[2]) >= 0 {
-                    let a = acc.get_or_insert_with(|| shader.start::<D>(t, e));
-                    written += shader.pixel(t, strip, base + n, a);
-                }
+            // Skip to the row's first covered pixel; interpolants start
+            // there, where every edge value is non-negative (no
+            // cancellation).
+            let mut n = 0usize;
+            while n <= max_n as usize && (e[0] | e[1] | e[2]) < 0 {
                 e[0] += step[0];
                 e[1] += step[1];
                 e[2] += step[2];
-                if let Some(a) = acc.as_mut() {
-                    shader.step::<D>(a);
+                n += 1;
+            }
+            if n <= max_n as usize {
+                let mut acc = shader.start::<D>(t, e);
+                for k in n..=max_n as usize {
+                    if (e[0] | e[1] | e[2]) >= 0 {
+                        written += shader.pixel(t, strip, base + k, &acc);
+                    }
+                    e[0] += step[0];
+                    e[1] += step[1];
+                    e[2] += step[2];
+                    shader.step::<D>(&mut acc);
                 }
             }
             for edge in edges.iter_mut() {
