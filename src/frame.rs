@@ -965,6 +965,122 @@ pub(crate) fn check_size(config: &Config) -> Result<(), Error> {
     }
 }
 
+/// The vertex stage: transform, outcode and (where no clipping can touch
+/// the vertex) snap, pairwise from `positions` into `out`.
+pub(crate) fn process_vertices<const S: u32>(
+    c: &Config,
+    guard: (f32, f32),
+    mvp: &Mat4,
+    positions: &[Vec3],
+    out: &mut [ProcessedVertex],
+) {
+    let (gx, gy) = guard;
+    for (p, v) in positions.iter().zip(out.iter_mut()) {
+        *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
+    }
+}
+
+/// The triangle stage over processed vertices, shared by [`Frame`] and
+/// [`StripRenderer`](crate::StripRenderer): every set-up triangle goes to
+/// `sink` (which returns `false` when it cannot take it: then this returns
+/// `Err(i)` for the triangle `i` that did not fit). Triangles for which
+/// `skip` (given the three clip positions) says so are counted in
+/// `outside_strip` after the frustum test.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn triangles_processed<const S: u32>(
+    c: &Config,
+    guard: (f32, f32),
+    mesh: &Mesh<'_>,
+    first_id: u32,
+    cache: &[ProcessedVertex],
+    stats: &mut Stats,
+    mut skip: impl FnMut([Vec4; 3]) -> bool,
+    mut sink: impl FnMut(SetupTriangle) -> bool,
+) -> Result<(), usize> {
+    // Colour lists as long as the mesh need no check per triangle.
+    let colors_complete = match mesh.colors {
+        MeshColors::Uniform(_) => true,
+        MeshColors::PerTriangle(cs) => cs.len() >= mesh.indices.len(),
+        MeshColors::PerVertex(cs) => cs.len() >= cache.len(),
+    };
+    for (i, idx) in mesh.indices.iter().enumerate() {
+        let id = first_id.wrapping_add(i as u32);
+        stats.submitted += 1;
+        let (Some(a), Some(b), Some(d)) = (
+            cache.get(idx[0] as usize),
+            cache.get(idx[1] as usize),
+            cache.get(idx[2] as usize),
+        ) else {
+            stats.rejected_index += 1;
+            continue;
+        };
+        // A missing colour counts as a bad index first, as in `draw_mesh`.
+        let colors_ok = colors_complete
+            || match mesh.colors {
+                MeshColors::Uniform(_) => true,
+                MeshColors::PerTriangle(cs) => i < cs.len(),
+                MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
+            };
+        if !colors_ok {
+            stats.rejected_index += 1;
+            continue;
+        }
+        let color = |k: usize| -> [f32; 3] {
+            rgb_f32(match mesh.colors {
+                MeshColors::Uniform(c) => c,
+                MeshColors::PerTriangle(cs) => cs.get(i).copied().unwrap_or_default(),
+                MeshColors::PerVertex(cs) => cs.get(idx[k] as usize).copied().unwrap_or_default(),
+            })
+        };
+        let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
+        if or & NONFINITE != 0 {
+            stats.rejected_nonfinite += 1;
+            continue;
+        }
+        if and & outcode::FRUSTUM != 0 {
+            stats.culled_frustum += 1;
+            continue;
+        }
+        if skip([a.pos, b.pos, d.pos]) {
+            stats.outside_strip += 1;
+            continue;
+        }
+        if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
+            // Fast path: vertices already snapped.
+            match setup_geometry::<S>(
+                &[a.snap, b.snap, d.snap],
+                c.width,
+                c.height,
+                c.cull,
+                c.front_face,
+            ) {
+                Ok(g) => {
+                    let t = g.finish(
+                        [a.inv_w, b.inv_w, d.inv_w],
+                        [color(0), color(1), color(2)],
+                        id,
+                    );
+                    if !sink(t) {
+                        return Err(i);
+                    }
+                    stats.stored += 1;
+                }
+                Err(r) => count_rejected(stats, r),
+            }
+            continue;
+        }
+        let v = [a, b, d];
+        let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
+            pos: v[k].pos,
+            color: color(k),
+        });
+        if !process::<S>(c, guard, &tri, id, stats, &mut sink) {
+            return Err(i);
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1089,120 +1205,4 @@ mod tests {
             ));
         }
     }
-}
-
-/// The vertex stage: transform, outcode and (where no clipping can touch
-/// the vertex) snap, pairwise from `positions` into `out`.
-pub(crate) fn process_vertices<const S: u32>(
-    c: &Config,
-    guard: (f32, f32),
-    mvp: &Mat4,
-    positions: &[Vec3],
-    out: &mut [ProcessedVertex],
-) {
-    let (gx, gy) = guard;
-    for (p, v) in positions.iter().zip(out.iter_mut()) {
-        *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, c.width, c.height);
-    }
-}
-
-/// The triangle stage over processed vertices, shared by [`Frame`] and
-/// [`StripRenderer`](crate::StripRenderer): every set-up triangle goes to
-/// `sink` (which returns `false` when it cannot take it: then this returns
-/// `Err(i)` for the triangle `i` that did not fit). Triangles for which
-/// `skip` (given the three clip positions) says so are counted in
-/// `outside_strip` after the frustum test.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn triangles_processed<const S: u32>(
-    c: &Config,
-    guard: (f32, f32),
-    mesh: &Mesh<'_>,
-    first_id: u32,
-    cache: &[ProcessedVertex],
-    stats: &mut Stats,
-    mut skip: impl FnMut([Vec4; 3]) -> bool,
-    mut sink: impl FnMut(SetupTriangle) -> bool,
-) -> Result<(), usize> {
-    // Colour lists as long as the mesh need no check per triangle.
-    let colors_complete = match mesh.colors {
-        MeshColors::Uniform(_) => true,
-        MeshColors::PerTriangle(cs) => cs.len() >= mesh.indices.len(),
-        MeshColors::PerVertex(cs) => cs.len() >= cache.len(),
-    };
-    for (i, idx) in mesh.indices.iter().enumerate() {
-        let id = first_id.wrapping_add(i as u32);
-        stats.submitted += 1;
-        let (Some(a), Some(b), Some(d)) = (
-            cache.get(idx[0] as usize),
-            cache.get(idx[1] as usize),
-            cache.get(idx[2] as usize),
-        ) else {
-            stats.rejected_index += 1;
-            continue;
-        };
-        // A missing colour counts as a bad index first, as in `draw_mesh`.
-        let colors_ok = colors_complete
-            || match mesh.colors {
-                MeshColors::Uniform(_) => true,
-                MeshColors::PerTriangle(cs) => i < cs.len(),
-                MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
-            };
-        if !colors_ok {
-            stats.rejected_index += 1;
-            continue;
-        }
-        let color = |k: usize| -> [f32; 3] {
-            rgb_f32(match mesh.colors {
-                MeshColors::Uniform(c) => c,
-                MeshColors::PerTriangle(cs) => cs.get(i).copied().unwrap_or_default(),
-                MeshColors::PerVertex(cs) => cs.get(idx[k] as usize).copied().unwrap_or_default(),
-            })
-        };
-        let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
-        if or & NONFINITE != 0 {
-            stats.rejected_nonfinite += 1;
-            continue;
-        }
-        if and & outcode::FRUSTUM != 0 {
-            stats.culled_frustum += 1;
-            continue;
-        }
-        if skip([a.pos, b.pos, d.pos]) {
-            stats.outside_strip += 1;
-            continue;
-        }
-        if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
-            // Fast path: vertices already snapped.
-            match setup_geometry::<S>(
-                &[a.snap, b.snap, d.snap],
-                c.width,
-                c.height,
-                c.cull,
-                c.front_face,
-            ) {
-                Ok(g) => {
-                    let t = g.finish(
-                        [a.inv_w, b.inv_w, d.inv_w],
-                        [color(0), color(1), color(2)],
-                        id,
-                    );
-                    if !sink(t) {
-                        return Err(i);
-                    }
-                    stats.stored += 1;
-                }
-                Err(r) => count_rejected(stats, r),
-            }
-            continue;
-        }
-        let v = [a, b, d];
-        let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
-            pos: v[k].pos,
-            color: color(k),
-        });
-        if !process::<S>(c, guard, &tri, id, stats, &mut sink) {
-            return Err(i);
-        }
-    }
-    Ok(())
 }
