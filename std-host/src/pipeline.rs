@@ -545,12 +545,31 @@ impl<const S: u32> FramePipeline<S> {
                 items.resize(need, 0);
             }
         }
-        let binned = frames
-            .iter()
-            .zip(bins.iter_mut())
-            .map(|(f, (o, i))| f.bin(strip_rows, o, i))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.to_string())?;
+        // One frame per setup worker: bin them in parallel too.
+        let binned = if frames.len() > 1 {
+            std::thread::scope(|s| {
+                let handles: Vec<_> = frames
+                    .iter()
+                    .zip(bins.iter_mut())
+                    .map(|(f, (o, i))| s.spawn(move || f.bin(strip_rows, o, i)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| {
+                        h.join()
+                            .map_err(|_| "binning worker failed".to_string())?
+                            .map_err(|e| e.to_string())
+                    })
+                    .collect::<Result<Vec<_>, String>>()
+            })?
+        } else {
+            frames
+                .iter()
+                .zip(bins.iter_mut())
+                .map(|(f, (o, i))| f.bin(strip_rows, o, i))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| e.to_string())?
+        };
         let layers: Vec<Layer<'_, '_, S>> = frames.iter().zip(binned.iter()).collect();
         let binning_ms = ms(t2);
         let mut stats = Stats::default();
