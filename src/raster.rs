@@ -381,11 +381,14 @@ fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
                 n += 1;
             }
             if n <= max_n as usize {
+                // Covered pixels of a row are contiguous (the triangle is
+                // convex): draw until the first uncovered one.
                 let mut acc = shader.start::<D>(t, e);
                 for k in n..=max_n as usize {
-                    if (e[0] | e[1] | e[2]) >= 0 {
-                        written += shader.pixel(t, strip, base + k, &acc);
+                    if (e[0] | e[1] | e[2]) < 0 {
+                        break;
                     }
+                    written += shader.pixel(t, strip, base + k, &acc);
                     e[0] += step[0];
                     e[1] += step[1];
                     e[2] += step[2];
