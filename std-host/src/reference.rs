@@ -182,6 +182,7 @@ impl Prepared {
         let sum = c[0] + c[1] + c[2];
         let mut inside = sum > 0.0;
         let mut edge_distance = f64::INFINITY;
+        #[allow(clippy::needless_range_loop)] // k indexes four arrays
         for k in 0..3 {
             let (a, b) = (self.a[k], self.b[k]);
             if c[k] < 0.0 {

@@ -805,6 +805,7 @@ fn compare(
             let sxm = p.sample(px - 1.0, py);
             let sym = p.sample(px, py - 1.0);
             let mut beyond = false;
+            #[allow(clippy::needless_range_loop)] // ch indexes several arrays
             for ch in 0..3 {
                 let exact = reference.color[i][ch];
                 let err = (core[ch] - (exact + 0.5).floor()).abs();
@@ -1418,7 +1419,7 @@ mod plot {
         });
         labels.push(Label {
             text: panel.y_label.into(),
-            at: (ox + 8, oy + margin_t as i32 - 16),
+            at: (ox + 8, oy + margin_t - 16),
             align: Alignment::Left,
             baseline: Baseline::Bottom,
             big: false,
