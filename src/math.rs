@@ -75,9 +75,19 @@ impl FloatFns for Micromath {
     fn tan(x: f32) -> f32 {
         micromath::F32Ext::tan(x)
     }
+    /// micromath's bit-trick estimate (up to 6 % off) refined by two Newton
+    /// steps (about `1e-6` relative): `look_at` normalises with it.
     #[inline]
     fn sqrt(x: f32) -> f32 {
-        micromath::F32Ext::sqrt(x)
+        if x == 0.0 {
+            return x;
+        }
+        let mut y = micromath::F32Ext::sqrt(x);
+        if y > 0.0 && y.is_finite() {
+            y = 0.5 * (y + x / y);
+            y = 0.5 * (y + x / y);
+        }
+        y
     }
 }
 
@@ -442,6 +452,17 @@ mod tests {
             && (a.y - b.y).abs() < 1e-5
             && (a.z - b.z).abs() < 1e-5
             && (a.w - b.w).abs() < 1e-5
+    }
+
+    #[cfg(feature = "micromath")]
+    #[test]
+    fn micromath_sqrt_is_refined() {
+        for x in [2.0f32, 0.5, 3.0, 1e-6, 1e6, 12345.678] {
+            let r = Micromath::sqrt(x);
+            let exact = (x as f64).sqrt();
+            assert!(((r as f64 - exact) / exact).abs() < 1e-5, "sqrt({x}) = {r}");
+        }
+        assert_eq!(Micromath::sqrt(0.0), 0.0);
     }
 
     #[test]

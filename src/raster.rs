@@ -24,7 +24,7 @@
 //! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
 //! at the start of each run of pixels (a row's first covered pixel for
 //! small triangles, every [`RESYNC`] pixels of a span) and stepped by its
-//! gradient in between; flat spans step it in `Z32.16` integers. The float
+//! gradient in between; spans step it in `Z32.16` integers. The float
 //! is `f64` for `u32` buffers: each term is at most `2^32` at a covered
 //! pixel, so the error is far below one `Z32` LSB and the written value is
 //! the floor of the exact plane value, or one off only where that value
@@ -41,7 +41,7 @@
 //! division per pixel.
 
 use crate::color::Pixel;
-use crate::depth::{DepthBuffer, DepthFunc};
+use crate::depth::{z32_at, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use embedded_graphics_core::pixelcolor::Rgb888;
 
@@ -300,15 +300,14 @@ impl<R: Real> Shader<R> {
         strip: &mut Strip<'_, C, D>,
         idx: usize,
         a: &Acc<R>,
+        z32: u32,
     ) -> u32 {
-        if D::ENABLED {
-            let z32 = a.z.to_u32(); // saturating, floors
-            if !strip
+        if D::ENABLED
+            && !strip
                 .depth
                 .test_and_set(idx, z32, strip.depth_func, strip.depth_write)
-            {
-                return 0;
-            }
+        {
+            return 0;
         }
         let rgb = if self.smooth {
             let inv = 1.0 / a.c[3];
@@ -388,7 +387,7 @@ fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
                     if (e[0] | e[1] | e[2]) < 0 {
                         break;
                     }
-                    written += shader.pixel(t, strip, base + k, &acc);
+                    written += shader.pixel(t, strip, base + k, &acc, acc.z.to_u32());
                     e[0] += step[0];
                     e[1] += step[1];
                     e[2] += step[2];
@@ -437,11 +436,16 @@ fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
                 edges[2].row + edges[2].step_x * lo,
             ];
             let mut acc = shader.start::<D>(t, e);
+            // Depth exactly as on a flat span (the same Z32.16 steps from
+            // the same start), so the written depth never depends on the
+            // pixel type; colour re-synchronises every RESYNC pixels.
+            let z0 = acc.z.to_fixed16();
             for n in lo..=hi {
                 if (n - lo) % RESYNC == 0 && n != lo {
                     acc = shader.start::<D>(t, e);
                 }
-                written += shader.pixel(t, strip, base + n as usize, &acc);
+                let z32 = z32_at(z0, shader.dz_fixed, (n - lo) as usize);
+                written += shader.pixel(t, strip, base + n as usize, &acc, z32);
                 e[0] += edges[0].step_x;
                 e[1] += edges[1].step_x;
                 e[2] += edges[2].step_x;

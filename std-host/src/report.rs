@@ -750,6 +750,9 @@ pub struct ErrorStats {
     pub color_mean: f64,
     /// Pixels whose colour error exceeds the explained bound.
     pub color_beyond: usize,
+    /// A few depth and colour errors beyond the bound:
+    /// `(x, y, id + 1, what, stored, exact)`.
+    pub beyond_examples: Vec<(u32, u32, u32, &'static str, String, String)>,
 }
 
 /// Compares a core image with the reference.
@@ -798,6 +801,16 @@ fn compare(
             depth_abs_sum += abs;
             if err > bound {
                 s.depth_beyond += 1;
+                if s.beyond_examples.len() < 5 {
+                    s.beyond_examples.push((
+                        (i % w) as u32,
+                        (i / w) as u32,
+                        a,
+                        "depth",
+                        depth[i].to_string(),
+                        format!("{ideal} (bound {bound:.1} LSB)"),
+                    ));
+                }
             }
             // Colour against the exact colour rounded to nearest.
             let c = color[i];
@@ -820,6 +833,16 @@ fn compare(
             }
             if beyond {
                 s.color_beyond += 1;
+                if s.beyond_examples.len() < 5 {
+                    s.beyond_examples.push((
+                        (i % w) as u32,
+                        (i / w) as u32,
+                        a,
+                        "colour",
+                        format!("{:?}", [c.r(), c.g(), c.b()]),
+                        format!("{:.2?}", reference.color[i]),
+                    ));
+                }
             }
             continue;
         }
@@ -1230,13 +1253,15 @@ pub fn markdown(info: &RunInfo, summary: &[Summary], rows: &[Row]) -> String {
         .map(|r| {
             format!(
                 "- {} {}: {} differing pixels unexplained, e.g. (x, y, core id+1, reference \
-                 id+1) {:?}; {} depth and {} colour errors beyond the bound",
+                 id+1) {:?}; {} depth and {} colour errors beyond the bound, e.g. (x, y, id+1, \
+                 what, stored, exact) {:?}",
                 r.scene,
                 r.config.label(),
                 r.errors.unexplained,
                 r.errors.unexplained_examples,
                 r.errors.depth_beyond,
                 r.errors.color_beyond,
+                r.errors.beyond_examples,
             )
         })
         .collect();
