@@ -83,18 +83,34 @@ pub trait DepthBuffer {
         write: bool,
         px: C,
     ) -> u32 {
-        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
-            return 0;
-        };
-        let mut written = 0;
-        for (n, cp) in c.iter_mut().enumerate() {
-            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
-                *cp = px;
-                written += 1;
-            }
-        }
-        written
+        flat_span_each(self, color, start, len, z0, dz, func, write, px)
     }
+}
+
+/// The pixel-by-pixel span loop behind [`DepthBuffer::flat_span`].
+#[allow(clippy::too_many_arguments)]
+fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
+    buf: &mut B,
+    color: &mut [C],
+    start: usize,
+    len: usize,
+    z0: i64,
+    dz: i64,
+    func: DepthFunc,
+    write: bool,
+    px: C,
+) -> u32 {
+    let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
+        return 0;
+    };
+    let mut written = 0;
+    for (n, cp) in c.iter_mut().enumerate() {
+        if buf.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
+            *cp = px;
+            written += 1;
+        }
+    }
+    written
 }
 
 /// `Z32` at step `n` of a span in `Z32.16` (wrapping, then clamped).
@@ -148,17 +164,7 @@ impl DepthBuffer for [u32] {
         if let Some(n) = fast_flat_span!(self, color, start, len, z0, dz, func, write, px, 0, u32) {
             return n;
         }
-        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
-            return 0;
-        };
-        let mut written = 0;
-        for (n, cp) in c.iter_mut().enumerate() {
-            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
-                *cp = px;
-                written += 1;
-            }
-        }
-        written
+        flat_span_each(self, color, start, len, z0, dz, func, write, px)
     }
 
     fn depth_len(&self) -> Option<usize> {
@@ -198,17 +204,7 @@ impl DepthBuffer for [u16] {
         {
             return n;
         }
-        let Some(c) = color.get_mut(start..start.saturating_add(len)) else {
-            return 0;
-        };
-        let mut written = 0;
-        for (n, cp) in c.iter_mut().enumerate() {
-            if self.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
-                *cp = px;
-                written += 1;
-            }
-        }
-        written
+        flat_span_each(self, color, start, len, z0, dz, func, write, px)
     }
 
     fn depth_len(&self) -> Option<usize> {

@@ -141,55 +141,37 @@ trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self>
     fn to_fixed16(self) -> i64;
 }
 
-impl Real for f64 {
-    const ZERO: f64 = 0.0;
-    #[inline(always)]
-    fn from_i64(v: i64) -> f64 {
-        v as f64
-    }
-    #[inline(always)]
-    fn from_u32(v: u32) -> f64 {
-        v as f64
-    }
-    #[inline(always)]
-    fn recip(self) -> f64 {
-        1.0 / self
-    }
-    #[inline(always)]
-    fn to_u32(self) -> u32 {
-        self as u32
-    }
-    #[inline(always)]
-    fn to_fixed16(self) -> i64 {
-        let q = self * 65536.0;
-        (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
-    }
+macro_rules! impl_real {
+    ($t:ty) => {
+        impl Real for $t {
+            const ZERO: $t = 0.0;
+            #[inline(always)]
+            fn from_i64(v: i64) -> $t {
+                v as $t
+            }
+            #[inline(always)]
+            fn from_u32(v: u32) -> $t {
+                v as $t
+            }
+            #[inline(always)]
+            fn recip(self) -> $t {
+                1.0 / self
+            }
+            #[inline(always)]
+            fn to_u32(self) -> u32 {
+                self as u32
+            }
+            #[inline(always)]
+            fn to_fixed16(self) -> i64 {
+                let q = self * 65536.0;
+                (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
+            }
+        }
+    };
 }
 
-impl Real for f32 {
-    const ZERO: f32 = 0.0;
-    #[inline(always)]
-    fn from_i64(v: i64) -> f32 {
-        v as f32
-    }
-    #[inline(always)]
-    fn from_u32(v: u32) -> f32 {
-        v as f32
-    }
-    #[inline(always)]
-    fn recip(self) -> f32 {
-        1.0 / self
-    }
-    #[inline(always)]
-    fn to_u32(self) -> u32 {
-        self as u32
-    }
-    #[inline(always)]
-    fn to_fixed16(self) -> i64 {
-        let q = self * 65536.0;
-        (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
-    }
-}
+impl_real!(f64);
+impl_real!(f32);
 
 /// Per-triangle constants for shading a covered pixel.
 struct Shader<R> {

@@ -498,7 +498,8 @@ fn cull_name(c: CullMode) -> &'static str {
     }
 }
 
-fn counters(s: &Stats) -> JsonObject {
+/// The core's counters as a JSON object (also `render --stats`).
+pub fn counters(s: &Stats) -> JsonObject {
     let mut c = JsonObject::new();
     c.field_u64("submitted", s.submitted as u64)
         .field_u64("culled_object", s.culled_object as u64)

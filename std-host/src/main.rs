@@ -102,18 +102,8 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
     }
     if args.stats {
         let s = r.stats;
-        let mut counters = JsonObject::new();
-        counters
-            .field_u64("submitted", s.submitted as u64)
-            .field_u64("culled_object", s.culled_object as u64)
-            .field_u64("culled_frustum", s.culled_frustum as u64)
-            .field_u64("culled_backface", s.culled_backface as u64)
-            .field_u64("culled_degenerate", s.culled_degenerate as u64)
-            .field_u64("rejected_nonfinite", s.rejected_nonfinite as u64)
-            .field_u64("rejected_index", s.rejected_index as u64)
-            .field_u64("clipped", s.clipped as u64)
-            .field_u64("stored", s.stored as u64)
-            .field_u64("pixels_written", r.pixels_written);
+        let mut counters = microraster_host::bench::counters(&s);
+        counters.field_u64("pixels_written", r.pixels_written);
         let mut timings = JsonObject::new();
         timings
             .field_f64("setup_ms", r.timings.setup_ms)
