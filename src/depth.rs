@@ -120,111 +120,69 @@ pub(crate) fn z32_at(z0: i64, dz: i64, n: usize) -> u32 {
     (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32
 }
 
-/// The branch-free span loop for `Less` / `LessEqual` with depth writes;
-/// `None` where it does not apply.
-macro_rules! fast_flat_span {
-    ($self:ident, $color:ident, $start:ident, $len:ident, $z0:ident, $dz:ident, $func:ident, $write:ident, $px:ident, $shift:expr, $t:ty) => {{
-        let end = $start.saturating_add($len);
-        if $write && matches!($func, DepthFunc::Less | DepthFunc::LessEqual) {
-            let (Some(c), Some(d)) = ($color.get_mut($start..end), $self.get_mut($start..end))
-            else {
-                return 0;
-            };
-            let le = $func == DepthFunc::LessEqual;
-            let mut written = 0u32;
-            for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
-                let z = (z32_at($z0, $dz, n) >> $shift) as $t;
-                let pass = z < *dp || (le && z == *dp);
-                *dp = if pass { z } else { *dp };
-                *cp = if pass { $px } else { *cp };
-                written += pass as u32;
-            }
-            Some(written)
-        } else {
-            None
-        }
-    }};
-}
+/// `[u32]` and `[u16]`: the buffer keeps `Z32 >> $shift`. Flat spans under
+/// `Less` / `LessEqual` with depth writes take a branch-free loop the
+/// compiler can vectorize; everything else goes pixel by pixel.
+macro_rules! impl_slice_depth {
+    ($t:ty, $wide:expr, $shift:expr) => {
+        impl DepthBuffer for [$t] {
+            const ENABLED: bool = true;
+            const WIDE: bool = $wide;
 
-impl DepthBuffer for [u32] {
-    const ENABLED: bool = true;
-    const WIDE: bool = true;
-
-    fn flat_span<C: Copy>(
-        &mut self,
-        color: &mut [C],
-        start: usize,
-        len: usize,
-        z0: i64,
-        dz: i64,
-        func: DepthFunc,
-        write: bool,
-        px: C,
-    ) -> u32 {
-        if let Some(n) = fast_flat_span!(self, color, start, len, z0, dz, func, write, px, 0, u32) {
-            return n;
-        }
-        flat_span_each(self, color, start, len, z0, dz, func, write, px)
-    }
-
-    fn depth_len(&self) -> Option<usize> {
-        Some(self.len())
-    }
-
-    #[inline]
-    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
-        match self.get_mut(index) {
-            Some(d) if func.test(z, *d) => {
-                if write {
-                    *d = z;
+            fn flat_span<C: Copy>(
+                &mut self,
+                color: &mut [C],
+                start: usize,
+                len: usize,
+                z0: i64,
+                dz: i64,
+                func: DepthFunc,
+                write: bool,
+                px: C,
+            ) -> u32 {
+                if !(write && matches!(func, DepthFunc::Less | DepthFunc::LessEqual)) {
+                    return flat_span_each(self, color, start, len, z0, dz, func, write, px);
                 }
-                true
-            }
-            _ => false,
-        }
-    }
-}
-
-impl DepthBuffer for [u16] {
-    const ENABLED: bool = true;
-    const WIDE: bool = false;
-
-    fn flat_span<C: Copy>(
-        &mut self,
-        color: &mut [C],
-        start: usize,
-        len: usize,
-        z0: i64,
-        dz: i64,
-        func: DepthFunc,
-        write: bool,
-        px: C,
-    ) -> u32 {
-        if let Some(n) = fast_flat_span!(self, color, start, len, z0, dz, func, write, px, 16, u16)
-        {
-            return n;
-        }
-        flat_span_each(self, color, start, len, z0, dz, func, write, px)
-    }
-
-    fn depth_len(&self) -> Option<usize> {
-        Some(self.len())
-    }
-
-    #[inline]
-    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
-        let z = (z >> 16) as u16;
-        match self.get_mut(index) {
-            Some(d) if func.test(z, *d) => {
-                if write {
-                    *d = z;
+                let end = start.saturating_add(len);
+                let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end))
+                else {
+                    return 0;
+                };
+                let le = func == DepthFunc::LessEqual;
+                let mut written = 0u32;
+                for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
+                    let z = (z32_at(z0, dz, n) >> $shift) as $t;
+                    let pass = z < *dp || (le && z == *dp);
+                    *dp = if pass { z } else { *dp };
+                    *cp = if pass { px } else { *cp };
+                    written += pass as u32;
                 }
-                true
+                written
             }
-            _ => false,
+
+            fn depth_len(&self) -> Option<usize> {
+                Some(self.len())
+            }
+
+            #[inline]
+            fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
+                let z = (z >> $shift) as $t;
+                match self.get_mut(index) {
+                    Some(d) if func.test(z, *d) => {
+                        if write {
+                            *d = z;
+                        }
+                        true
+                    }
+                    _ => false,
+                }
+            }
         }
-    }
+    };
 }
+
+impl_slice_depth!(u32, true, 0);
+impl_slice_depth!(u16, false, 16);
 
 /// No depth buffer: every fragment passes and no depth is computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
