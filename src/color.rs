@@ -2,16 +2,16 @@
 //!
 //! Design note: the rasterizer computes a fragment's colour as [`Rgb888`]
 //! (8 bits a channel) and hands it with the triangle's index to
-//! [`Pixel::from_fragment`]. Colour types convert with embedded-graphics'
+//! [`PixelFormat::from_fragment`]. Colour types convert with embedded-graphics'
 //! own `From<Rgb888>` conversions: `Rgb565` keeps the top 5/6/5 bits of each
 //! channel, `Gray8` takes the luma, `BinaryColor` is on when the luma is at
-//! least half. [`TriangleId`] ignores colour ([`Pixel::SHADED`] is `false`,
+//! least half. [`TriangleId`] ignores colour ([`PixelFormat::SHADED`] is `false`,
 //! so no colour is computed) and records which triangle won each pixel.
 
 use embedded_graphics_core::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888};
 
 /// A pixel format the rasterizer can write.
-pub trait Pixel: Copy {
+pub trait PixelFormat: Copy {
     /// Whether the fragment colour is needed; `false` skips shading.
     const SHADED: bool;
 
@@ -19,7 +19,7 @@ pub trait Pixel: Copy {
     fn from_fragment(rgb: Rgb888, triangle: u32) -> Self;
 }
 
-impl Pixel for Rgb888 {
+impl PixelFormat for Rgb888 {
     const SHADED: bool = true;
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
@@ -27,7 +27,7 @@ impl Pixel for Rgb888 {
     }
 }
 
-impl Pixel for Rgb565 {
+impl PixelFormat for Rgb565 {
     const SHADED: bool = true;
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
@@ -35,7 +35,7 @@ impl Pixel for Rgb565 {
     }
 }
 
-impl Pixel for Gray8 {
+impl PixelFormat for Gray8 {
     const SHADED: bool = true;
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
@@ -43,7 +43,7 @@ impl Pixel for Gray8 {
     }
 }
 
-impl Pixel for BinaryColor {
+impl PixelFormat for BinaryColor {
     const SHADED: bool = true;
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
@@ -56,7 +56,7 @@ impl Pixel for BinaryColor {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct TriangleId(pub u32);
 
-impl Pixel for TriangleId {
+impl PixelFormat for TriangleId {
     const SHADED: bool = false;
     #[inline]
     fn from_fragment(_: Rgb888, triangle: u32) -> Self {

@@ -48,8 +48,9 @@ impl DepthFunc {
 
 /// Depth storage for the rows being rendered.
 ///
-/// Implemented for `[u16]`, `[u32]` and [`NoDepth`]. Pass `&mut depth[..]`
-/// (or `&mut NoDepth`) to [`Frame::render_rows`](crate::Frame::render_rows).
+/// Implemented for slices and arrays of [`DepthWord`]s (`u16`, `u32`) and
+/// for [`NoDepth`]. Pass `&mut depth` (or `&mut NoDepth`) to
+/// [`Frame::render_rows`](crate::Frame::render_rows).
 pub trait DepthBuffer {
     /// `false` only for [`NoDepth`]: no depth value is computed at all.
     const ENABLED: bool;
@@ -120,69 +121,140 @@ pub(crate) fn z32_at(z0: i64, dz: i64, n: usize) -> u32 {
     (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32
 }
 
-/// `[u32]` and `[u16]`: the buffer keeps `Z32 >> $shift`. Flat spans under
-/// `Less` / `LessEqual` with depth writes take a branch-free loop the
-/// compiler can vectorize; everything else goes pixel by pixel.
-macro_rules! impl_slice_depth {
-    ($t:ty, $wide:expr, $shift:expr) => {
-        impl DepthBuffer for [$t] {
-            const ENABLED: bool = true;
-            const WIDE: bool = $wide;
-
-            fn flat_span<C: Copy>(
-                &mut self,
-                color: &mut [C],
-                start: usize,
-                len: usize,
-                z0: i64,
-                dz: i64,
-                func: DepthFunc,
-                write: bool,
-                px: C,
-            ) -> u32 {
-                if !(write && matches!(func, DepthFunc::Less | DepthFunc::LessEqual)) {
-                    return flat_span_each(self, color, start, len, z0, dz, func, write, px);
-                }
-                let end = start.saturating_add(len);
-                let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end))
-                else {
-                    return 0;
-                };
-                let le = func == DepthFunc::LessEqual;
-                let mut written = 0u32;
-                for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
-                    let z = (z32_at(z0, dz, n) >> $shift) as $t;
-                    let pass = z < *dp || (le && z == *dp);
-                    *dp = if pass { z } else { *dp };
-                    *cp = if pass { px } else { *cp };
-                    written += pass as u32;
-                }
-                written
-            }
-
-            fn depth_len(&self) -> Option<usize> {
-                Some(self.len())
-            }
-
-            #[inline]
-            fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
-                let z = (z >> $shift) as $t;
-                match self.get_mut(index) {
-                    Some(d) if func.test(z, *d) => {
-                        if write {
-                            *d = z;
-                        }
-                        true
-                    }
-                    _ => false,
-                }
-            }
-        }
-    };
+/// A depth-buffer word: `u16` (the top 16 bits of `Z32`) or `u32` (`Z32`).
+///
+/// The one trait for depth values: buffers of them are [`DepthBuffer`]s
+/// (slices and arrays), and [`StripDrawer`](crate::StripDrawer) clears them
+/// to [`DepthWord::FAR`] or any `Z32` value.
+pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'static {
+    /// The far plane (`Z32` 1.0): the clear value for [`DepthFunc::Less`].
+    const FAR: Self;
+    /// The near plane (`Z32` 0).
+    const NEAR: Self;
+    /// Whether the word keeps more than 24 bits, so depth is interpolated
+    /// in `f64` (`u32`); `u16` uses `f32`, which is exact enough for 16
+    /// bits and cheap on cores without a double-precision FPU.
+    const WIDE: bool;
+    /// The word for a `Z32` depth.
+    fn from_z32(z: u32) -> Self;
+    /// The word as `Z32` (a `u16` gives its value times `2^16`).
+    fn to_z32(self) -> u32;
 }
 
-impl_slice_depth!(u32, true, 0);
-impl_slice_depth!(u16, false, 16);
+impl DepthWord for u16 {
+    const FAR: Self = u16::MAX;
+    const NEAR: Self = 0;
+    const WIDE: bool = false;
+    #[inline(always)]
+    fn from_z32(z: u32) -> Self {
+        (z >> 16) as u16
+    }
+    #[inline(always)]
+    fn to_z32(self) -> u32 {
+        (self as u32) << 16
+    }
+}
+
+impl DepthWord for u32 {
+    const FAR: Self = u32::MAX;
+    const NEAR: Self = 0;
+    const WIDE: bool = true;
+    #[inline(always)]
+    fn from_z32(z: u32) -> Self {
+        z
+    }
+    #[inline(always)]
+    fn to_z32(self) -> u32 {
+        self
+    }
+}
+
+/// Slices of depth words. Flat spans under `Less` / `LessEqual` with depth
+/// writes take a branch-free loop the compiler can vectorize; everything
+/// else goes pixel by pixel.
+impl<W: DepthWord> DepthBuffer for [W] {
+    const ENABLED: bool = true;
+    const WIDE: bool = W::WIDE;
+
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        func: DepthFunc,
+        write: bool,
+        px: C,
+    ) -> u32 {
+        if !(write && matches!(func, DepthFunc::Less | DepthFunc::LessEqual)) {
+            return flat_span_each(self, color, start, len, z0, dz, func, write, px);
+        }
+        let end = start.saturating_add(len);
+        let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end)) else {
+            return 0;
+        };
+        let le = func == DepthFunc::LessEqual;
+        let mut written = 0u32;
+        for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
+            let z = W::from_z32(z32_at(z0, dz, n));
+            let pass = z < *dp || (le && z == *dp);
+            *dp = if pass { z } else { *dp };
+            *cp = if pass { px } else { *cp };
+            written += pass as u32;
+        }
+        written
+    }
+
+    fn depth_len(&self) -> Option<usize> {
+        Some(self.len())
+    }
+
+    #[inline]
+    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
+        let z = W::from_z32(z);
+        match self.get_mut(index) {
+            Some(d) if func.test(z, *d) => {
+                if write {
+                    *d = z;
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+/// Arrays of depth words, as their slices: `&mut [u16; N]` works wherever
+/// `&mut [u16]` does.
+impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
+    const ENABLED: bool = true;
+    const WIDE: bool = W::WIDE;
+
+    #[inline]
+    fn flat_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        func: DepthFunc,
+        write: bool,
+        px: C,
+    ) -> u32 {
+        self[..].flat_span(color, start, len, z0, dz, func, write, px)
+    }
+
+    fn depth_len(&self) -> Option<usize> {
+        Some(N)
+    }
+
+    #[inline]
+    fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
+        self[..].test_and_set(index, z, func, write)
+    }
+}
 
 /// No depth buffer: every fragment passes and no depth is computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

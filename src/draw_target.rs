@@ -20,7 +20,7 @@
 //! - [`StripDrawer::draw_frame`] renders an already set-up [`Frame`], which
 //!   costs setup storage but sets each triangle up once.
 //!
-//! Colours: the strip buffer holds pixels of any [`Pixel`] type `P` and the
+//! Colours: the strip buffer holds pixels of any [`PixelFormat`] type `P` and the
 //! target's colour must convert from it (`T::Color: From<P>`). With `P` the
 //! target's own colour (`Rgb565`, `Rgb888`, `Gray8`, `BinaryColor`) that is
 //! the identity, and each fragment was converted once, from the rasterizer's
@@ -30,11 +30,13 @@
 //! least 128. A wider buffer (`Rgb888`) into a narrower target converts at
 //! push time with the same `From`, so the pixels are the same.
 
-use crate::color::Pixel;
-use crate::depth::{DepthBuffer, NoDepth};
+use crate::color::PixelFormat;
+use crate::config::{Config, Error};
+use crate::depth::{DepthBuffer, DepthWord, NoDepth};
 use crate::fixed::SUBPIXEL_BITS;
-use crate::frame::{Config, Error, Frame, RenderStats};
-use crate::immediate::StripRenderer;
+use crate::frame::Frame;
+use crate::stats::RenderStats;
+use crate::strip_renderer::StripRenderer;
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
@@ -87,36 +89,29 @@ pub trait StripDepth {
     fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut Self::Rows>;
 }
 
-macro_rules! strip_depth {
-    ($t:ty, $z:expr) => {
-        impl StripDepth for &mut [$t] {
-            type Rows = [$t];
-            fn held(&self) -> Option<usize> {
-                Some(self.len())
-            }
-            fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [$t]> {
-                let rows = self.get_mut(..len)?;
-                rows.fill($z(z32));
-                Some(rows)
-            }
-        }
-
-        impl<const N: usize> StripDepth for &mut [$t; N] {
-            type Rows = [$t];
-            fn held(&self) -> Option<usize> {
-                Some(N)
-            }
-            fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [$t]> {
-                let rows = self.get_mut(..len)?;
-                rows.fill($z(z32));
-                Some(rows)
-            }
-        }
-    };
+impl<W: DepthWord> StripDepth for &mut [W] {
+    type Rows = [W];
+    fn held(&self) -> Option<usize> {
+        Some(self.len())
+    }
+    fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
+        let rows = self.get_mut(..len)?;
+        rows.fill(W::from_z32(z32));
+        Some(rows)
+    }
 }
 
-strip_depth!(u16, |z: u32| (z >> 16) as u16);
-strip_depth!(u32, |z: u32| z);
+impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
+    type Rows = [W];
+    fn held(&self) -> Option<usize> {
+        Some(N)
+    }
+    fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
+        let rows = self.get_mut(..len)?;
+        rows.fill(W::from_z32(z32));
+        Some(rows)
+    }
+}
 
 impl StripDepth for NoDepth {
     type Rows = NoDepth;
@@ -140,7 +135,7 @@ impl StripDepth for NoDepth {
 /// ```
 /// use embedded_graphics::{mock_display::MockDisplay, prelude::Point};
 /// use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
-/// use microraster::{Config, CullMode, StripDrawer, Vec4};
+/// use microraster::{Config, CullMode, StripDrawer, Submit, Vec4};
 ///
 /// // A 24x16 frame drawn 4 rows at a time: the strip buffers hold 4 rows.
 /// let mut color = [Rgb565::BLACK; 24 * 4];
@@ -154,7 +149,8 @@ impl StripDepth for NoDepth {
 ///     .draw(&mut display, config, |strip| {
 ///         // Called once per strip: submit the whole scene each time.
 ///         let v = |x, y| Vec4::new(x, y, 0.5, 1.0);
-///         strip.push_clip_triangle([v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)], [Rgb888::RED; 3], 0);
+///         strip.submit_clip_triangle([v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)], [Rgb888::RED; 3], 0)
+///             .unwrap();
 ///     })
 ///     .unwrap();
 ///
@@ -181,7 +177,7 @@ impl<P, D> core::fmt::Debug for StripDrawer<'_, P, D> {
     }
 }
 
-impl<'b, P: Pixel, D: StripDepth> StripDrawer<'b, P, D> {
+impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
     /// A drawer with the strip buffers `color` and `depth` (pass
     /// `&mut depth` or [`NoDepth`]), clearing colour to
     /// `background`. Frames land at the target's `(0, 0)`.
@@ -251,7 +247,8 @@ impl<'b, P: Pixel, D: StripDepth> StripDrawer<'b, P, D> {
         F: FnMut(&mut StripRenderer<'_, P, D::Rows, S>),
     {
         self.for_each_strip(target, config, |y0, y1, color, depth| {
-            let mut strip = StripRenderer::<P, D::Rows, S>::new(config, y0, y1, color, depth)?;
+            let mut strip =
+                StripRenderer::<P, D::Rows, S>::with_subpixel_bits(config, y0, y1, color, depth)?;
             scene(&mut strip);
             Ok(strip.render_stats())
         })
@@ -286,7 +283,7 @@ impl<'b, P: Pixel, D: StripDepth> StripDrawer<'b, P, D> {
         T::Color: From<P>,
         R: FnMut(u32, u32, &mut [P], &mut D::Rows) -> Result<RenderStats, Error>,
     {
-        crate::frame::check_size(&config)?;
+        crate::config::check_size(&config)?;
         let (width, height) = (config.width, config.height);
         let rows = self.strip_rows(width).min(height);
         let full = width as usize * rows as usize;
@@ -342,8 +339,9 @@ mod tests {
     extern crate std;
 
     use super::*;
-    use crate::frame::CullMode;
+    use crate::config::CullMode;
     use crate::math::Vec4;
+    use crate::pipeline::Submit;
     use crate::setup::SetupTriangle;
     use embedded_graphics::mock_display::{ColorMapping, MockDisplay};
     use embedded_graphics_core::pixelcolor::{
@@ -388,10 +386,10 @@ mod tests {
     }
 
     /// The frame rendered in one piece with [`Frame::render_rows`].
-    fn reference<P: Pixel>(background: P) -> Vec<P> {
+    fn reference<P: PixelFormat>(background: P) -> Vec<P> {
         let mut storage = [SetupTriangle::EMPTY; 16];
         let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
-        scene(|p, c, id| frame.push_clip_triangle(p, c, id).unwrap());
+        scene(|p, c, id| frame.submit_clip_triangle(p, c, id).unwrap());
         let mut color = vec![background; (W * H) as usize];
         let mut depth = vec![u16::MAX; (W * H) as usize];
         frame.render_rows(0, H, &mut color, &mut depth[..]).unwrap();
@@ -413,13 +411,13 @@ mod tests {
     /// render.
     fn every_pixel_once<P>(background: P)
     where
-        P: Pixel + PixelColor + ColorMapping + core::fmt::Debug,
+        P: PixelFormat + PixelColor + ColorMapping + core::fmt::Debug,
     {
         let origin = Point::new(5, 11);
         let expected = expected_display(&reference(background), origin);
         let mut storage = [SetupTriangle::EMPTY; 16];
         let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
-        scene(|p, c, id| frame.push_clip_triangle(p, c, id).unwrap());
+        scene(|p, c, id| frame.submit_clip_triangle(p, c, id).unwrap());
         for rows in [1, 3, 7, 16, 39, 40, 64] {
             let mut color = vec![background; (W * rows) as usize];
             let mut depth = vec![0u16; (W * rows) as usize];
@@ -430,7 +428,7 @@ mod tests {
             let mut display = MockDisplay::<P>::new();
             drawer
                 .draw(&mut display, config(), |strip| {
-                    scene(|p, c, id| strip.push_clip_triangle(p, c, id))
+                    scene(|p, c, id| strip.submit_clip_triangle(p, c, id).unwrap())
                 })
                 .unwrap();
             display.assert_eq_with_message(&expected, |f| write!(f, "immediate, {rows} rows"));
@@ -474,7 +472,7 @@ mod tests {
         let mut depth = vec![0u16; (W * 8) as usize];
         let mut drawer = StripDrawer::new(&mut color, &mut depth[..], Rgb888::BLACK);
         let submit = |strip: &mut StripRenderer<'_, Rgb888, [u16]>| {
-            scene(|p, c, id| strip.push_clip_triangle(p, c, id))
+            scene(|p, c, id| strip.submit_clip_triangle(p, c, id).unwrap())
         };
 
         let mut d565 = MockDisplay::<Rgb565>::new();
@@ -514,11 +512,13 @@ mod tests {
                 // Window (px, py) of an 8x6 frame in NDC: x = -1 + px / 4,
                 // y = 1 - py / 3.
                 let p = |px: f32, py: f32| v(-1.0 + px / 4.0, 1.0 - py / 3.0, 0.0);
-                strip.push_clip_triangle(
-                    [p(0.5, 0.5), p(6.5, 0.5), p(6.5, 6.5)],
-                    [Rgb888::WHITE; 3],
-                    0,
-                );
+                strip
+                    .submit_clip_triangle(
+                        [p(0.5, 0.5), p(6.5, 0.5), p(6.5, 6.5)],
+                        [Rgb888::WHITE; 3],
+                        0,
+                    )
+                    .unwrap();
             })
             .unwrap();
         display.assert_pattern(&[
@@ -582,7 +582,7 @@ mod tests {
         let mut calls = 0;
         let r = drawer.draw(&mut target, config(), |strip| {
             calls += 1;
-            scene(|p, c, id| strip.push_clip_triangle(p, c, id));
+            scene(|p, c, id| strip.submit_clip_triangle(p, c, id).unwrap());
         });
         assert_eq!(r, Err(DrawError::Target("display unplugged")));
         assert_eq!((target.strips, calls), (2, 2));
@@ -648,7 +648,9 @@ mod tests {
             .draw(&mut display, c, |strip| {
                 scene(|p, col, id| {
                     // Mirror z about 0 so the nearest stays in front.
-                    strip.push_clip_triangle(p.map(|q| Vec4::new(q.x, q.y, -q.z, q.w)), col, id)
+                    strip
+                        .submit_clip_triangle(p.map(|q| Vec4::new(q.x, q.y, -q.z, q.w)), col, id)
+                        .unwrap()
                 })
             })
             .unwrap();

@@ -62,7 +62,14 @@ pub struct SnappedVertex {
 /// `S` subpixel bits: clipping keeps `|x| <= gx * w` and `|y| <= gy * w`.
 ///
 /// Chosen so that `(gx + 1) * width / 2 * 2^S <= GUARD_BAND`.
+///
+/// `S` must be 4 or 8: any other value fails to compile.
+///
+/// ```compile_fail
+/// let _ = microraster::fixed::guard_band_ndc::<32>(64, 64);
+/// ```
 pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
+    const { check_subpixel_bits::<S>() };
     let limit = (GUARD_BAND >> S) as f32; // pixels
     let gx = 2.0 * limit / width as f32 - 1.0;
     let gy = 2.0 * limit / height as f32 - 1.0;
@@ -92,6 +99,13 @@ fn round_to_coord(v: f32) -> Option<i32> {
     Some(i + up - down)
 }
 
+/// Fails to compile unless `S` is a supported subpixel precision (4 or 8):
+/// `const { check_subpixel_bits::<S>() }` in every function generic over
+/// `S` turns a bad `S` into a build error, never a run-time shift overflow.
+pub(crate) const fn check_subpixel_bits<const S: u32>() {
+    assert!(S == 4 || S == 8, "subpixel bits must be 4 or 8");
+}
+
 /// Snaps a clip-space position to window space at `S` subpixel bits.
 ///
 /// Window x = `(x/w + 1) * width / 2`, window y = `(1 - y/w) * height / 2`
@@ -99,6 +113,16 @@ fn round_to_coord(v: f32) -> Option<i32> {
 /// scaled by `2^S` and rounded to the nearest integer, halves up. Returns
 /// `None` if `w` is not positive or a result is not finite or beyond
 /// [`COORD_LIMIT`]; the caller counts that as rejected.
+///
+/// The arithmetic is `f32`, as on the vertex stage's fast path. Where that
+/// fails for a finite input with `w > 0` (a `1 / w` beyond `f32`'s range,
+/// which clipping can produce for `w` near `1e-38`), the same formula is
+/// evaluated in `f64` instead, so such a vertex lands where it really is.
+/// `S` must be 4 or 8:
+///
+/// ```compile_fail
+/// let _ = microraster::fixed::snap::<32>(0.0, 0.0, 0.0, 1.0, 8, 8);
+/// ```
 pub fn snap<const S: u32>(
     x: f32,
     y: f32,
@@ -107,10 +131,49 @@ pub fn snap<const S: u32>(
     width: u32,
     height: u32,
 ) -> Option<SnappedVertex> {
+    const { check_subpixel_bits::<S>() };
     if w.is_nan() || w <= 0.0 {
         return None;
     }
     snap_inv::<S>(x, y, z, 1.0 / w, width, height)
+        .or_else(|| snap_f64::<S>(x, y, z, w, width, height))
+}
+
+/// [`snap`] in `f64`, for the rare finite vertex whose `f32` evaluation
+/// overflows.
+fn snap_f64<const S: u32>(
+    x: f32,
+    y: f32,
+    z: f32,
+    w: f32,
+    width: u32,
+    height: u32,
+) -> Option<SnappedVertex> {
+    let (x, y, z, w) = (x as f64, y as f64, z as f64, w as f64);
+    let half_w = width as f64 * 0.5;
+    let half_h = height as f64 * 0.5;
+    let scale = (1u32 << S) as f64;
+    let wx = (x / w * half_w + half_w) * scale;
+    let wy = (half_h - y / w * half_h) * scale;
+    let zw = z / w * 0.5 + 0.5;
+    if !(zw.is_finite() && wx.is_finite() && wy.is_finite()) {
+        return None;
+    }
+    let limit = COORD_LIMIT as f64;
+    if wx.abs() > limit || wy.abs() > limit {
+        return None;
+    }
+    // Nearest, halves up; exact in f64 for |v| <= 2^28.
+    let round = |v: f64| {
+        let i = v as i64;
+        let f = v - i as f64;
+        (i + (f >= 0.5) as i64 - (f < -0.5) as i64) as i32
+    };
+    Some(SnappedVertex {
+        x: round(wx),
+        y: round(wy),
+        z: z01_to_z32(zw as f32),
+    })
 }
 
 /// [`snap`] with `1 / w` already computed (and `w > 0` already checked).
@@ -123,6 +186,7 @@ pub(crate) fn snap_inv<const S: u32>(
     width: u32,
     height: u32,
 ) -> Option<SnappedVertex> {
+    const { check_subpixel_bits::<S>() };
     let half_w = width as f32 * 0.5;
     let half_h = height as f32 * 0.5;
     let scale = (1u32 << S) as f32;
@@ -148,8 +212,17 @@ pub fn z01_to_z32(z: f32) -> u32 {
 }
 
 /// The `Sub<S>` coordinate of the centre of pixel column (or row) `i`.
+/// `S` must be 4 or 8:
+///
+/// ```compile_fail
+/// let _ = microraster::fixed::pixel_center::<0>(1);
+/// ```
+/// ```compile_fail
+/// let _ = microraster::fixed::pixel_center::<64>(1);
+/// ```
 #[inline]
 pub const fn pixel_center<const S: u32>(i: i32) -> i64 {
+    const { check_subpixel_bits::<S>() };
     ((i as i64) << S) + (1i64 << (S - 1))
 }
 

@@ -39,34 +39,81 @@
 //! Set up a frame's triangles once with [`Frame`], then render any rows
 //! `y0..y1` into buffers that hold only those rows, with
 //! [`Frame::render_rows`]. Any split of the frame gives the same pixels.
+//! Where RAM is scarcer than cycles, [`StripRenderer`] draws each submitted
+//! triangle straight into the one strip it holds, and [`StripDrawer`]
+//! pushes strips to any embedded-graphics `DrawTarget`. Triangles and
+//! meshes go to either through the one [`Submit`] trait (in the
+//! [`prelude`]).
+//!
+//! ## From `Vec3` to pixel: the stages and their files
+//!
+//! The modules are listed here, and declared below, in pipeline order:
+//!
+//! | stage | file | what happens |
+//! |---|---|---|
+//! | settings | `config.rs` | [`Config`], [`CullMode`], [`FrontFace`], the [`Error`]s |
+//! | vertex math | `math.rs` | [`Vec3`], [`Mat4`], the `f32` float backends |
+//! | meshes, vertex stage | `mesh.rs` | [`Mesh`], [`BoundingSphere`] (object cull), [`ProcessedVertex`] (transform, outcode, snap once per vertex) |
+//! | submission | `pipeline.rs` | [`Submit`]: object cull, frustum cull, strip skip, then clip and setup for each triangle |
+//! | clipping | `clip.rs` | outcodes; homogeneous clipping against near, far and the guard band |
+//! | fixed point | `fixed.rs` | snapping to `Sub<S>` window coordinates: where floats end |
+//! | setup | `setup.rs` | exact integer area, culling, winding, bounding box: [`SetupTriangle`] |
+//! | counters | `stats.rs` | [`Stats`] (per triangle), [`RenderStats`] (per pixel) |
+//! | storage | `frame.rs`, `bins.rs` | [`Frame`]: set-up triangles in caller storage, per-strip [`Bins`] |
+//! | immediate mode | `strip_renderer.rs` | [`StripRenderer`]: setup straight into one strip |
+//! | traversal | `raster.rs` | exact edge functions, top-left rule, spans, depth and colour steps |
+//! | depth | `depth.rs` | [`DepthBuffer`], [`DepthWord`] (`u16`, `u32`), [`NoDepth`], [`DepthFunc`] |
+//! | pixels | `color.rs` | [`PixelFormat`]: embedded-graphics colours, [`TriangleId`] |
+//! | display | `draw_target.rs` | [`StripDrawer`]: strips into a `DrawTarget` |
 
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs, missing_debug_implementations)]
 
-pub mod clip;
-mod color;
-mod depth;
-mod draw_target;
-pub mod fixed;
-mod frame;
-mod immediate;
+mod config;
 pub mod math;
-mod raster;
+mod mesh;
+mod pipeline;
+pub mod clip;
+pub mod fixed;
 mod setup;
+mod stats;
+mod bins;
+mod frame;
+mod strip_renderer;
+mod raster;
+mod depth;
+mod color;
+mod draw_target;
 
+pub use bins::Bins;
 pub use clip::ClipVertex;
-pub use color::{Pixel, TriangleId};
-pub use depth::{DepthBuffer, DepthFunc, NoDepth};
+pub use color::{PixelFormat, TriangleId};
+pub use config::{Config, CullMode, Error, FrontFace};
+pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
-pub use frame::{
-    Bins, BoundingSphere, Config, CullMode, Error, Frame, FrontFace, Mesh, MeshColors,
-    ProcessedVertex, RenderStats, Stats,
-};
-pub use immediate::StripRenderer;
+pub use frame::Frame;
 pub use math::{Mat4, Vec3, Vec4};
+pub use mesh::{BoundingSphere, Mesh, MeshColors, ProcessedVertex};
+pub use pipeline::{Submit, MAX_PIECES};
 pub use setup::SetupTriangle;
+pub use stats::{RenderStats, Stats};
+pub use strip_renderer::StripRenderer;
+
+#[doc(hidden)]
+pub use pipeline::__private;
+
+/// The traits a program drawing with microraster needs in scope, and the
+/// colour types, as in `embedded_graphics::prelude`.
+pub mod prelude {
+    pub use crate::color::PixelFormat;
+    pub use crate::depth::{DepthBuffer, DepthWord};
+    pub use crate::pipeline::Submit;
+    pub use embedded_graphics_core::pixelcolor::{
+        BinaryColor, Gray8, GrayColor, Rgb565, Rgb888, RgbColor,
+    };
+}
 
 /// Colour types from embedded-graphics, re-exported for convenience.
 pub use embedded_graphics_core::pixelcolor;

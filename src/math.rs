@@ -284,13 +284,28 @@ impl Mat4 {
         }
     }
 
-    /// Row `r` as an array.
-    pub const fn row(&self, r: usize) -> [f32; 4] {
-        [
+    /// Row `r` as an array, `None` for `r > 3`.
+    pub const fn row(&self, r: usize) -> Option<[f32; 4]> {
+        if r > 3 {
+            return None;
+        }
+        Some([
             self.cols[0][r],
             self.cols[1][r],
             self.cols[2][r],
             self.cols[3][r],
+        ])
+    }
+
+    /// The four rows, as the matrix is written on paper (the inverse of
+    /// [`Mat4::from_rows`]).
+    pub const fn rows(&self) -> [[f32; 4]; 4] {
+        let c = &self.cols;
+        [
+            [c[0][0], c[1][0], c[2][0], c[3][0]],
+            [c[0][1], c[1][1], c[2][1], c[3][1]],
+            [c[0][2], c[1][2], c[2][2], c[3][2]],
+            [c[0][3], c[1][3], c[2][3], c[3][3]],
         ]
     }
 

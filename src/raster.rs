@@ -40,7 +40,7 @@
 //! start of each run and the four sums stepped in `f32` along it; one
 //! division per pixel.
 
-use crate::color::Pixel;
+use crate::color::PixelFormat;
 use crate::depth::{z32_at, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use embedded_graphics_core::pixelcolor::Rgb888;
@@ -199,7 +199,7 @@ struct Acc<R> {
 }
 
 impl<R: Real> Shader<R> {
-    fn new<C: Pixel, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Self {
+    fn new<C: PixelFormat, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Self {
         let (mut k1, mut k2, mut dz) = (R::ZERO, R::ZERO, R::ZERO);
         if D::ENABLED {
             let inv_area = R::from_i64(t.area).recip();
@@ -276,7 +276,7 @@ impl<R: Real> Shader<R> {
     /// Depth-tests and writes the pixel at `idx` with interpolants `a`.
     /// Returns 1 if written.
     #[inline(always)]
-    fn pixel<C: Pixel, D: DepthBuffer + ?Sized>(
+    fn pixel<C: PixelFormat, D: DepthBuffer + ?Sized>(
         &self,
         t: &SetupTriangle,
         strip: &mut Strip<'_, C, D>,
@@ -310,7 +310,7 @@ impl<R: Real> Shader<R> {
 
 /// Draws one triangle into the strip; returns the number of pixels written.
 #[inline]
-pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
+pub(crate) fn draw<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized>(
     t: &SetupTriangle,
     strip: &mut Strip<'_, C, D>,
 ) -> u32 {
@@ -322,7 +322,7 @@ pub(crate) fn draw<const S: u32, C: Pixel, D: DepthBuffer + ?Sized>(
 }
 
 /// [`draw`] with depth interpolated in `R`.
-fn draw_in<const S: u32, C: Pixel, D: DepthBuffer + ?Sized, R: Real>(
+fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
     t: &SetupTriangle,
     strip: &mut Strip<'_, C, D>,
 ) -> u32 {

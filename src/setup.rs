@@ -4,8 +4,8 @@
 //! everything that does not depend on the rows being rendered:
 //!
 //! 1. snap the three vertices ([`crate::fixed::snap`]); a vertex that
-//!    cannot be snapped (non-finite, `w <= 0` after clipping) rejects the
-//!    triangle;
+//!    cannot be snapped (the homogeneous origin) makes the triangle
+//!    degenerate;
 //! 2. twice the signed area, exactly, in `i64` (`|area| < 2^59`): zero area
 //!    is rejected, the sign decides back-face culling;
 //! 3. the winding is normalised so the area is positive (vertices 1 and 2
@@ -20,8 +20,8 @@
 //! record small for RAM-starved targets.
 
 use crate::clip::ClipVertex;
+use crate::config::{CullMode, FrontFace};
 use crate::fixed::{snap, SnappedVertex};
-use crate::frame::{CullMode, FrontFace};
 use embedded_graphics_core::pixelcolor::Rgb888;
 
 /// A triangle after setup, ready to rasterize into any rows of its frame.
@@ -114,8 +114,21 @@ pub(crate) enum Rejected {
     Degenerate,
     /// The bounding box misses the frame.
     Offscreen,
-    /// A vertex could not be snapped (non-finite or `w <= 0`).
-    NonFinite,
+}
+
+/// `1 / w` of three vertices with `w > 0`, for perspective-correct
+/// attributes (only their ratios matter). In `f32` as a rule; where that
+/// overflows (`w` below about `3e-39`, which clipping can produce) the
+/// weights are formed in `f64` relative to the smallest `w`, so they stay
+/// finite.
+#[inline]
+pub(crate) fn inv_w3(w: [f32; 3]) -> [f32; 3] {
+    let iw = w.map(|w| 1.0 / w);
+    if iw.iter().all(|v| v.is_finite()) {
+        return iw;
+    }
+    let m = (w[0] as f64).min(w[1] as f64).min(w[2] as f64);
+    w.map(|w| (m / w as f64) as f32)
 }
 
 /// Twice the signed area of a triangle in window space (y down), exactly.
@@ -138,11 +151,14 @@ pub(crate) fn setup<const S: u32>(
     let mut s = [SnappedVertex::default(); 3];
     for k in 0..3 {
         let p = v[k].pos;
-        s[k] = snap::<S>(p.x, p.y, p.z, p.w, width, height).ok_or(Rejected::NonFinite)?;
+        // Unclipped, finite and inside the guard band, a vertex fails to
+        // snap only if it is the homogeneous origin (w = 0 forces x = y =
+        // z = 0 there): no point at all, so the triangle is degenerate.
+        s[k] = snap::<S>(p.x, p.y, p.z, p.w, width, height).ok_or(Rejected::Degenerate)?;
     }
     let g = setup_geometry::<S>(&s, width, height, cull, front)?;
     Ok(g.finish(
-        [1.0 / v[0].pos.w, 1.0 / v[1].pos.w, 1.0 / v[2].pos.w],
+        inv_w3([v[0].pos.w, v[1].pos.w, v[2].pos.w]),
         [v[0].color, v[1].color, v[2].color],
         id,
     ))

@@ -17,9 +17,10 @@ use common::*;
 use microraster::clip::outcode;
 use microraster::fixed::guard_band_ndc;
 use microraster::pixelcolor::Rgb888;
+use microraster::prelude::*;
 use microraster::{
-    ClipVertex, Config, CullMode, DepthFunc, Error, Frame, FrontFace, Mat4, Mesh, MeshColors,
-    NoDepth, ProcessedVertex, Stats, StripRenderer, TriangleId, Vec3, Vec4,
+    BoundingSphere, ClipVertex, Config, CullMode, DepthFunc, Error, Frame, FrontFace, Mat4, Mesh,
+    MeshColors, NoDepth, ProcessedVertex, Stats, StripRenderer, TriangleId, Vec3, Vec4,
 };
 use proptest::prelude::*;
 
@@ -303,9 +304,9 @@ fn check_strips<const S: u32>(
     let mut cfg = config_nocull(w, h);
     cfg.depth_func = func;
     let mut st = storage(tris.len());
-    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    let mut frame = Frame::<S>::with_subpixel_bits(cfg, &mut st).unwrap();
     for (i, (p, c)) in tris.iter().enumerate() {
-        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+        frame.submit_clip_triangle(*p, *c, i as u32).unwrap();
     }
     let whole = render_strips(&frame, &[0, h]);
     let mut all = vec![0];
@@ -525,9 +526,9 @@ fn shoot<const S: u32>(w: u32, h: u32, tris: &[([Vec4; 3], [Rgb888; 3])]) -> Sho
     let mut cfg = config_nocull(w, h);
     cfg.depth_func = DepthFunc::LessEqual;
     let mut st = storage(tris.len());
-    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    let mut frame = Frame::<S>::with_subpixel_bits(cfg, &mut st).unwrap();
     for (i, (p, c)) in tris.iter().enumerate() {
-        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+        frame.submit_clip_triangle(*p, *c, i as u32).unwrap();
     }
     let n = (w * h) as usize;
     let mut color = vec![Rgb888::new(0, 0, 0); n];
@@ -646,24 +647,19 @@ fn any_triangle() -> impl Strategy<Value = [Vec4; 3]> {
     prop_oneof![6 => general, 1 => degenerate, 1 => tiny]
 }
 
-fn dropped(s: &Stats) -> u32 {
-    s.culled_object
-        + s.culled_frustum
-        + s.culled_backface
-        + s.culled_degenerate
-        + s.rejected_nonfinite
-        + s.rejected_index
+fn dropped(s: &Stats) -> u64 {
+    s.dropped()
 }
 
 fn check_stats<const S: u32>(cfg: Config, tris: &[[Vec4; 3]]) -> Result<(), TestCaseError> {
     let mut st = storage(tris.len());
-    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
-    let mut kept = 0u32;
+    let mut frame = Frame::<S>::with_subpixel_bits(cfg, &mut st).unwrap();
+    let mut kept = 0u64;
     for (i, t) in tris.iter().enumerate() {
         let before = frame.stats();
         let len = frame.triangles().len();
         frame
-            .push_clip_triangle(*t, [Rgb888::new(9, 9, 9); 3], i as u32)
+            .submit_clip_triangle(*t, [Rgb888::new(9, 9, 9); 3], i as u32)
             .unwrap();
         let after = frame.stats();
         let d_stored = after.stored - before.stored;
@@ -671,7 +667,7 @@ fn check_stats<const S: u32>(cfg: Config, tris: &[[Vec4; 3]]) -> Result<(), Test
         let d_clipped = after.clipped - before.clipped;
         let pieces = frame.triangles().len() - len;
         prop_assert_eq!(after.submitted - before.submitted, 1);
-        prop_assert_eq!(pieces as u32, d_stored, "stored counts the pieces");
+        prop_assert_eq!(pieces as u64, d_stored, "stored counts the pieces");
         prop_assert!(
             (d_dropped == 1 && d_stored == 0) || (d_dropped == 0 && d_stored >= 1),
             "{:?}: counted {} times, stored {}: {:?} -> {:?}",
@@ -693,10 +689,10 @@ fn check_stats<const S: u32>(cfg: Config, tris: &[[Vec4; 3]]) -> Result<(), Test
         if non_finite {
             prop_assert_eq!(after.rejected_nonfinite - before.rejected_nonfinite, 1);
         }
-        kept += (d_stored > 0) as u32;
+        kept += (d_stored > 0) as u64;
     }
     let s = frame.stats();
-    prop_assert_eq!(s.submitted, tris.len() as u32);
+    prop_assert_eq!(s.submitted, tris.len() as u64);
     prop_assert_eq!(s.submitted, dropped(&s) + kept);
     prop_assert_eq!(s.stored as usize, frame.triangles().len());
     // And whatever was stored renders without panicking, in strips too.
@@ -733,7 +729,7 @@ proptest! {
         prop_assume!(pos.iter().all(|p| outcode(*p, gx, gy) & outcode::CLIP == 0));
         let mut st = storage(1);
         let mut frame = Frame::<8>::new(config_nocull(w, h), &mut st).unwrap();
-        frame.push_clip_triangle(pos, [Rgb888::new(0, 0, 0); 3], 0).unwrap();
+        frame.submit_clip_triangle(pos, [Rgb888::new(0, 0, 0); 3], 0).unwrap();
         let s = frame.stats();
         prop_assert_eq!(s.clipped, 0);
         prop_assert_eq!(s.stored + dropped(&s), 1);
@@ -751,7 +747,7 @@ proptest! {
             ClipVertex { pos: Vec4::new(0.0, 1.0, 0.0, 1.0), color: [1.0; 3] },
         ];
         tri[k].color[ch] = bad;
-        frame.push_triangle(tri, 0).unwrap();
+        frame.submit_triangle(tri, 0).unwrap();
         prop_assert_eq!(frame.stats().rejected_nonfinite, 1);
         prop_assert_eq!(frame.triangles().len(), 0);
     }
@@ -786,7 +782,7 @@ proptest! {
         let mut st = storage(tris.len());
         let mut frame: Frame = Frame::new(config_nocull(w, h), &mut st).unwrap();
         for (i, (p, c)) in tris.iter().enumerate() {
-            frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+            frame.submit_clip_triangle(*p, *c, i as u32).unwrap();
         }
         let (wc, wz, wid) = whole_frame(&frame);
         let strips = h.div_ceil(strip_rows) as usize;
@@ -796,7 +792,7 @@ proptest! {
         prop_assert_eq!(bins.strips() as usize, strips);
         let (mut c, mut z, mut ids) = (vec![], vec![], vec![]);
         for s in 0..bins.strips() {
-            let (y0, y1) = bins.rows(s, h);
+            let (y0, y1) = bins.rows(s);
             let n = (w * (y1 - y0)) as usize;
             let mut sc = vec![Rgb888::new(1, 2, 3); n];
             let mut sz = vec![u32::MAX; n];
@@ -867,9 +863,9 @@ proptest! {
         let mut st2 = storage(indices.len());
         let mut a: Frame = Frame::new(cfg, &mut st1).unwrap();
         let mut b: Frame = Frame::new(cfg, &mut st2).unwrap();
-        a.draw_mesh(&mesh, &mvp, 5).unwrap();
+        a.submit_mesh(&mesh, &mvp, 5).unwrap();
         let mut cache = vec![ProcessedVertex::EMPTY; positions.len()];
-        b.draw_mesh_cached(&mesh, &mvp, 5, &mut cache).unwrap();
+        b.submit_mesh_cached(&mesh, &mvp, 5, &mut cache).unwrap();
         // (With a colour list too short for the mesh the two paths count
         // some triangles under different reasons: see the ignored
         // `draw_mesh_cached_counts_missing_colours_like_draw_mesh`.)
@@ -892,14 +888,14 @@ proptest! {
         let mut c = vec![Rgb888::new(1, 2, 3); n];
         let mut z = vec![u32::MAX; n];
         let mut r: StripRenderer<'_, Rgb888, [u32]> = StripRenderer::new(cfg, 0, h, &mut c[..], &mut z[..]).unwrap();
-        r.draw_mesh(&mesh, &mvp, 5);
+        r.submit_mesh(&mesh, &mvp, 5).unwrap();
         prop_assert_eq!(r.stats(), a.stats());
         prop_assert!(c == wa.0 && z == wa.1, "immediate mode differs");
         // A cache shorter than the mesh is refused.
         if !positions.is_empty() {
             let mut short = vec![ProcessedVertex::EMPTY; positions.len() - 1];
             prop_assert_eq!(
-                b.draw_mesh_cached(&mesh, &mvp, 5, &mut short),
+                b.submit_mesh_cached(&mesh, &mvp, 5, &mut short),
                 Err(Error::VertexCacheSize { expected: positions.len(), actual: positions.len() - 1 })
             );
         }
@@ -914,9 +910,9 @@ fn check_strip_renderer<const S: u32>(
 ) -> Result<(), TestCaseError> {
     let cfg = config_nocull(w, h);
     let mut st = storage(tris.len());
-    let mut frame = Frame::<S>::new(cfg, &mut st).unwrap();
+    let mut frame = Frame::<S>::with_subpixel_bits(cfg, &mut st).unwrap();
     for (i, (p, c)) in tris.iter().enumerate() {
-        frame.push_clip_triangle(*p, *c, i as u32).unwrap();
+        frame.submit_clip_triangle(*p, *c, i as u32).unwrap();
     }
     let mut all = vec![0];
     all.extend(cuts.iter().copied().filter(|&c| c < h));
@@ -932,9 +928,9 @@ fn check_strip_renderer<const S: u32>(
         let mut c = vec![Rgb888::new(1, 2, 3); n];
         let mut z = vec![0xFFFFu16; n];
         let mut r: StripRenderer<'_, Rgb888, [u16], S> =
-            StripRenderer::new(cfg, y0, y1, &mut c[..], &mut z[..]).unwrap();
+            StripRenderer::with_subpixel_bits(cfg, y0, y1, &mut c[..], &mut z[..]).unwrap();
         for (i, (p, col)) in tris.iter().enumerate() {
-            r.push_clip_triangle(*p, *col, i as u32);
+            r.submit_clip_triangle(*p, *col, i as u32).unwrap();
         }
         // A strip skips triangles wholly above or below it before setup
         // (`outside_strip`); apart from those it counts what the frame does.
@@ -972,10 +968,80 @@ fn draw_mesh_cached_counts_missing_colours_like_draw_mesh() {
     let (mut s1, mut s2) = (storage(1), storage(1));
     let mut a: Frame = Frame::new(Config::new(8, 8), &mut s1).unwrap();
     let mut b: Frame = Frame::new(Config::new(8, 8), &mut s2).unwrap();
-    a.draw_mesh(&mesh, &Mat4::IDENTITY, 0).unwrap();
+    a.submit_mesh(&mesh, &Mat4::IDENTITY, 0).unwrap();
     let mut cache = [ProcessedVertex::EMPTY; 3];
-    b.draw_mesh_cached(&mesh, &Mat4::IDENTITY, 0, &mut cache)
+    b.submit_mesh_cached(&mesh, &Mat4::IDENTITY, 0, &mut cache)
         .unwrap();
     assert_eq!(a.stats().rejected_index, 1);
     assert_eq!(b.stats(), a.stats());
+}
+
+// ---------------------------------------------------------------------------
+// Object culling is conservative
+// ---------------------------------------------------------------------------
+
+/// A small mesh anywhere (offsets up to 1e7, sizes from a few ulps to
+/// hundreds of units) seen from a camera beside it or far from it.
+fn object_scene() -> impl Strategy<Value = (Vec<Vec3>, Vec3, Vec3, f32, f32)> {
+    let coord = prop_oneof![-2.0f32..2.0, -1e5f32..1e5, -1e7f32..1e7];
+    let scale = prop_oneof![Just(0.0f32), 1e-3f32..1.0, 1.0f32..300.0];
+    (
+        [coord.clone(), coord.clone(), coord],
+        scale,
+        proptest::collection::vec([-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0], 3..9),
+        [-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0],
+        prop_oneof![1e-3f32..1.0, 1.0f32..1e3],
+        0.2f32..2.5,
+        prop_oneof![Just(0.001f32), 0.01f32..1.0],
+    )
+        .prop_map(|(c, scale, pts, dir, dist, fov, near)| {
+            let c = Vec3::new(c[0], c[1], c[2]);
+            let ulps = |v: f32| (f32::from_bits(v.abs().to_bits() + 1) - v.abs()) * 4.0;
+            let s = Vec3::new(
+                scale.max(ulps(c.x)),
+                scale.max(ulps(c.y)),
+                scale.max(ulps(c.z)),
+            );
+            let positions = pts
+                .iter()
+                .map(|p| Vec3::new(c.x + p[0] * s.x, c.y + p[1] * s.y, c.z + p[2] * s.z))
+                .collect::<Vec<_>>();
+            let eye = c + Vec3::new(dir[0], dir[1], dir[2] + 0.01) * dist;
+            // Look at the mesh, or past it, so it may be on screen or not.
+            let target = c + Vec3::new(dir[1], -dir[0], dir[2]) * (dist * 0.5);
+            (positions, eye, target, fov, near)
+        })
+}
+
+proptest! {
+    #![proptest_config(cases(2000))]
+
+    /// The image (and every counter but the object's) is the same with and
+    /// without a bounding sphere, for every scene.
+    #[test]
+    fn bounding_sphere_culling_never_changes_the_image(
+        (positions, eye, target, fov, near) in object_scene()
+    ) {
+        let n = positions.len() as u32;
+        let indices = (1..n - 1).map(|i| [0, i, i + 1]).collect::<Vec<_>>();
+        let mvp = Mat4::perspective(fov, 1.0, near, near * 1e5)
+            * Mat4::look_at(eye, target, Vec3::new(0.0, 1.0, 0.0));
+        prop_assume!(mvp.is_finite());
+        let mut mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: MeshColors::Uniform(Rgb888::new(7, 8, 9)),
+            bounds: None,
+        };
+        let draw = |mesh: &Mesh<'_>| {
+            let mut st = storage(indices.len() * 8);
+            let mut frame = Frame::new(config_nocull(48, 48), &mut st).unwrap();
+            frame.submit_mesh(mesh, &mvp, 0).unwrap();
+            (frame_ids(&frame), frame.stats())
+        };
+        let (without, _) = draw(&mesh);
+        mesh.bounds = BoundingSphere::from_points(&positions);
+        let (with, stats) = draw(&mesh);
+        prop_assert_eq!(&with, &without, "culled_object {}", stats.culled_object);
+    }
 }

@@ -14,6 +14,7 @@ mod common;
 
 use common::HitCounter;
 use microraster::pixelcolor::Rgb888;
+use microraster::prelude::*;
 use microraster::{
     Config, CullMode, Frame, Mat4, Mesh, MeshColors, SetupTriangle, TriangleId, Vec3,
 };
@@ -47,8 +48,8 @@ fn counts<const S: u32>(mesh: &Mesh<'_>, mvp: &Mat4, w: u32, h: u32, cull: CullM
     let mut config = Config::new(w, h);
     config.cull = cull;
     let mut storage = vec![SetupTriangle::EMPTY; mesh.indices.len() * 2];
-    let mut frame = Frame::<S>::new(config, &mut storage).unwrap();
-    frame.draw_mesh(mesh, mvp, 0).unwrap();
+    let mut frame = Frame::<S>::with_subpixel_bits(config, &mut storage).unwrap();
+    frame.submit_mesh(mesh, mvp, 0).unwrap();
     let n = (w * h) as usize;
     let mut hits = vec![0u32; n];
     let mut ids = vec![TriangleId(0); n];

@@ -15,7 +15,7 @@
 //! first, rows top to bottom.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
-use microraster::{Config, Frame, NoDepth, SetupTriangle};
+use microraster::{Config, Frame, NoDepth, SetupTriangle, Submit};
 use microraster_scenes::cubes;
 use std::env;
 use std::fmt::Write as _;
@@ -74,9 +74,9 @@ fn fnv1a_rgb565(pixels: &[Rgb565]) -> u64 {
 
 fn host_checksum(depth: bool) -> u64 {
     let mut storage = vec![SetupTriangle::EMPTY; cubes::CUBE_INDICES.len() * 4 * 7];
-    let mut frame: Frame = Frame::new(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
+    let mut frame = Frame::new(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
     cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| {
-        frame.draw_mesh(mesh, mvp, id).unwrap()
+        frame.submit_mesh(mesh, mvp, id).unwrap()
     });
     let n = (WIDTH * HEIGHT) as usize;
     let mut color = vec![Rgb565::BLACK; n];

@@ -209,8 +209,8 @@ pub fn mvps(width: u32, height: u32) -> [Mat4; 4] {
 }
 
 /// Calls `draw(mesh, mvp, first_id)` for each cube in drawing order; the
-/// triangle ids run 0..48. Works with `Frame::draw_mesh` and
-/// `StripRenderer::draw_mesh` alike.
+/// triangle ids run 0..48. Works with `Submit::submit_mesh` on a `Frame`
+/// and a `StripRenderer` alike.
 pub fn for_each_cube(width: u32, height: u32, mut draw: impl FnMut(&Mesh<'static>, &Mat4, u32)) {
     for (i, mvp) in mvps(width, height).iter().enumerate() {
         draw(&MESH, mvp, (i * CUBE_INDICES.len()) as u32);
@@ -341,7 +341,7 @@ mod tests {
         // model_matrix agrees with applying the ops in order (M = R * T).
         for ops in &CUBE_MODELS {
             let m = model_matrix(ops);
-            assert_eq!(m.row(3), [0.0, 0.0, 0.0, 1.0]);
+            assert_eq!(m.row(3), Some([0.0, 0.0, 0.0, 1.0]));
             for p in CUBE_VERTICES {
                 let q = m.transform_point(Vec3::from_array(p));
                 assert!(close([q.x, q.y, q.z], transform_point(ops, p)));

@@ -18,6 +18,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
+use microraster::prelude::Submit;
 use microraster::{Config, Frame, Mesh, ProcessedVertex, SetupTriangle};
 use microraster_host::bench_scenes::{self, View};
 use microraster_host::render::Object;
@@ -99,14 +100,14 @@ fn stages(c: &mut Criterion) {
         g.bench_function("setup/draw_mesh", |b| {
             b.iter(|| {
                 let mut f = Frame::<8>::new(config, &mut storage).expect("frame");
-                f.draw_mesh(&mesh, &o.mvp, 0).expect("fits");
+                f.submit_mesh(&mesh, &o.mvp, 0).expect("fits");
                 black_box(f.stats())
             })
         });
         g.bench_function("setup/draw_mesh_cached", |b| {
             b.iter(|| {
                 let mut f = Frame::<8>::new(config, &mut storage).expect("frame");
-                f.draw_mesh_cached(&mesh, &o.mvp, 0, &mut cache)
+                f.submit_mesh_cached(&mesh, &o.mvp, 0, &mut cache)
                     .expect("fits");
                 black_box(f.stats())
             })
@@ -114,7 +115,7 @@ fn stages(c: &mut Criterion) {
 
         // One set-up frame for binning and drawing.
         let mut frame = Frame::<8>::new(config, &mut storage).expect("frame");
-        frame.draw_mesh(&mesh, &o.mvp, 0).expect("fits");
+        frame.submit_mesh(&mesh, &o.mvp, 0).expect("fits");
         let strips = config.height.div_ceil(STRIP_ROWS) as usize;
         let mut offsets = vec![0u32; strips + 1];
         let mut items = vec![0u32; frame.bin_entries(STRIP_ROWS)];
@@ -164,7 +165,7 @@ fn raster<C, T>(
     offsets: &mut [u32],
     items: &mut [u32],
 ) where
-    C: microraster::Pixel + RgbColor,
+    C: microraster::PixelFormat + RgbColor,
     T: Depth,
     [T]: microraster::DepthBuffer,
 {

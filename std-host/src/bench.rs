@@ -51,7 +51,7 @@ use crate::render::{self, fnv1a64, DepthKind, RenderOptions, Scene, BACKGROUND};
 use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
-use microraster::{Config, CullMode, Error, Pixel, Stats, TriangleId, Vec4};
+use microraster::{Config, CullMode, Error, PixelFormat, Stats, TriangleId, Vec4};
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -501,15 +501,15 @@ fn cull_name(c: CullMode) -> &'static str {
 /// The core's counters as a JSON object (also `render --stats`).
 pub fn counters(s: &Stats) -> JsonObject {
     let mut c = JsonObject::new();
-    c.field_u64("submitted", s.submitted as u64)
-        .field_u64("culled_object", s.culled_object as u64)
-        .field_u64("culled_frustum", s.culled_frustum as u64)
-        .field_u64("culled_backface", s.culled_backface as u64)
-        .field_u64("culled_degenerate", s.culled_degenerate as u64)
-        .field_u64("rejected_nonfinite", s.rejected_nonfinite as u64)
-        .field_u64("rejected_index", s.rejected_index as u64)
-        .field_u64("clipped", s.clipped as u64)
-        .field_u64("stored", s.stored as u64);
+    c.field_u64("submitted", s.submitted)
+        .field_u64("culled_object", s.culled_object)
+        .field_u64("culled_frustum", s.culled_frustum)
+        .field_u64("culled_backface", s.culled_backface)
+        .field_u64("culled_degenerate", s.culled_degenerate)
+        .field_u64("rejected_nonfinite", s.rejected_nonfinite)
+        .field_u64("rejected_index", s.rejected_index)
+        .field_u64("clipped", s.clipped)
+        .field_u64("stored", s.stored);
     c
 }
 
@@ -599,7 +599,7 @@ fn ms(t: Instant) -> f64 {
 // Formats and strips.
 
 /// A colour format the benchmark draws into.
-pub trait BenchColor: Pixel + Send + Sync + PartialEq + 'static {
+pub trait BenchColor: PixelFormat + Send + Sync + PartialEq + 'static {
     /// The background.
     const CLEAR: Self;
     /// The same format packed for euc.

@@ -20,8 +20,9 @@
 //! any strip height.
 
 use crate::render::{ObjectColors, Scene};
+use microraster::prelude::Submit;
 use microraster::{
-    Bins, ClipVertex, Config, Error, Frame, MeshColors, NoDepth, Pixel, ProcessedVertex,
+    Bins, ClipVertex, Config, Error, Frame, MeshColors, NoDepth, PixelFormat, ProcessedVertex,
     SetupTriangle, Stats, Vec4,
 };
 use std::ops::Range;
@@ -116,8 +117,8 @@ pub fn fill<const S: u32>(
                 }
                 let id = first_ids[*i].wrapping_add(r.start as u32);
                 match caches.get(*i).copied().flatten() {
-                    Some(cache) => frame.draw_mesh_processed(&mesh, id, cache)?,
-                    None => frame.draw_mesh(&mesh, &o.mvp, id)?,
+                    Some(cache) => frame.submit_processed_mesh(&mesh, id, cache)?,
+                    None => frame.submit_mesh(&mesh, &o.mvp, id)?,
                 }
             }
             Piece::ClipTris(r) => {
@@ -128,26 +129,12 @@ pub fn fill<const S: u32>(
                         pos: Vec4::from_array(p),
                         color,
                     });
-                    frame.push_triangle(v, clip_first.wrapping_add((r.start + k) as u32))?;
+                    frame.submit_triangle(v, clip_first.wrapping_add((r.start + k) as u32))?;
                 }
             }
         }
     }
     Ok(())
-}
-
-/// Adds the counters `o` to `a`.
-pub fn add_stats(a: &mut Stats, o: &Stats) {
-    a.submitted += o.submitted;
-    a.culled_object += o.culled_object;
-    a.culled_frustum += o.culled_frustum;
-    a.culled_backface += o.culled_backface;
-    a.culled_degenerate += o.culled_degenerate;
-    a.rejected_nonfinite += o.rejected_nonfinite;
-    a.rejected_index += o.rejected_index;
-    a.clipped += o.clipped;
-    a.stored += o.stored;
-    a.outside_strip += o.outside_strip;
 }
 
 // ---------------------------------------------------------------------------
@@ -158,7 +145,7 @@ pub trait DepthFormat: Copy + Send + Sync + 'static {
     /// The cleared (farthest) value.
     const CLEAR: Self;
     /// `frame.render_strip` with this depth slice; the pixels written.
-    fn render_strip<const S: u32, C: Pixel>(
+    fn render_strip<const S: u32, C: PixelFormat>(
         frame: &Frame<'_, S>,
         bins: &Bins<'_>,
         strip: u32,
@@ -171,7 +158,7 @@ macro_rules! depth_format {
     ($t:ty) => {
         impl DepthFormat for $t {
             const CLEAR: Self = <$t>::MAX;
-            fn render_strip<const S: u32, C: Pixel>(
+            fn render_strip<const S: u32, C: PixelFormat>(
                 frame: &Frame<'_, S>,
                 bins: &Bins<'_>,
                 strip: u32,
@@ -266,7 +253,7 @@ pub type Layer<'a, 'f, const S: u32> = (&'a Frame<'f, S>, &'a Bins<'a>);
 /// strips of `rows` rows) on `threads` workers, clearing each strip first
 /// (colour to `clear`, depth to [`DepthFormat::CLEAR`]) if `clear` is given.
 /// Returns the pixels written.
-pub fn draw_layers<const S: u32, C: Pixel + Send + Sync, T: DepthFormat>(
+pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthFormat>(
     layers: &[Layer<'_, '_, S>],
     color: &mut [C],
     depth: Option<&mut [T]>,
@@ -360,7 +347,7 @@ fn build_chunk<'s, const S: u32>(
     pieces: &[Piece],
     caches: &[Option<&[ProcessedVertex]>],
 ) -> Built<'s, S> {
-    let mut f = Frame::<S>::new(config, storage).map_err(|e| e.to_string())?;
+    let mut f = Frame::<S>::with_subpixel_bits(config, storage).map_err(|e| e.to_string())?;
     match fill(&mut f, scene, pieces, caches) {
         Ok(()) => Ok(Ok(f)),
         Err(Error::StorageFull { needed, .. }) => Ok(Err(needed)),
@@ -410,7 +397,7 @@ fn vertex_stage<'c, const S: u32>(
     scene: &Scene,
     caches: &'c mut Vec<Vec<ProcessedVertex>>,
 ) -> Result<Vec<Option<&'c [ProcessedVertex]>>, String> {
-    let probe = Frame::<S>::new(config, &mut []).map_err(|e| e.to_string())?;
+    let probe = Frame::<S>::with_subpixel_bits(config, &mut []).map_err(|e| e.to_string())?;
     if caches.len() < scene.objects.len() {
         caches.resize_with(scene.objects.len(), Vec::new);
     }
@@ -574,7 +561,7 @@ impl<const S: u32> FramePipeline<S> {
         let binning_ms = ms(t2);
         let mut stats = Stats::default();
         for f in &frames {
-            add_stats(&mut stats, &f.stats());
+            stats += f.stats();
         }
         let out = then(&layers)?;
         Ok((
@@ -591,7 +578,7 @@ impl<const S: u32> FramePipeline<S> {
     /// Renders one frame of `scene` into `color` and `depth` (cleared
     /// first, strip by strip). Returns the setup times, the raster time in
     /// milliseconds and the pixels written.
-    pub fn render<C: Pixel + Send + Sync, T: DepthFormat>(
+    pub fn render<C: PixelFormat + Send + Sync, T: DepthFormat>(
         &mut self,
         scene: &Scene,
         color: &mut [C],

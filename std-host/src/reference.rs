@@ -430,6 +430,7 @@ pub mod mat {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use microraster::prelude::Submit;
 
     fn opts(w: u32, h: u32, cull: CullMode) -> RefOptions {
         RefOptions {
@@ -608,7 +609,7 @@ mod tests {
                 Vec4::new(q[0], q[1], q[2], q[3])
             });
             let white = microraster::pixelcolor::Rgb888::new(255, 255, 255);
-            frame.push_clip_triangle(p, [white; 3], t.id).unwrap();
+            frame.submit_clip_triangle(p, [white; 3], t.id).unwrap();
         }
         let mut ids = vec![TriangleId(0); (w * h) as usize];
         frame.render_rows(0, h, &mut ids, &mut NoDepth).unwrap();
@@ -669,8 +670,8 @@ mod tests {
         );
         for r in 0..4 {
             for k in 0..4 {
-                assert!((p[r][k] - c.row(r)[k] as f64).abs() < 1e-5);
-                assert!((v[r][k] - cv.row(r)[k] as f64).abs() < 1e-5);
+                assert!((p[r][k] - c.rows()[r][k] as f64).abs() < 1e-5);
+                assert!((v[r][k] - cv.rows()[r][k] as f64).abs() < 1e-5);
             }
         }
         let r = mat::mul(&mat::rotation_z(0.5), &mat::translation([1.0, 0.0, 0.0]));

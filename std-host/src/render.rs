@@ -17,7 +17,7 @@ use crate::cliptris::ClipTri;
 use crate::pipeline::{draw_layers, DepthFormat, FramePipeline, Layer};
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::{
-    BoundingSphere, Config, CullMode, Mat4, Mesh, MeshColors, Pixel, Stats, TriangleId, Vec3,
+    BoundingSphere, Config, CullMode, Mat4, Mesh, MeshColors, PixelFormat, Stats, TriangleId, Vec3,
 };
 use std::time::Instant;
 
@@ -326,7 +326,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
 /// Draws the binned frames `layers` into `color` with a new depth buffer
 /// `kind`, every strip cleared to `clear` first. Returns the depth buffer
 /// after drawing and the pixels written.
-fn draw_image<const S: u32, C: Pixel + Send + Sync>(
+fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
     layers: &[Layer<'_, '_, S>],
     color: &mut [C],
     kind: DepthKind,

@@ -46,6 +46,7 @@ use crate::reference::{self, mat, Prepared, RefImage, RefOptions, RefTriangle, R
 use clap::Args;
 use microraster::math::{radians, FloatFns, Libm, Micromath};
 use microraster::pixelcolor::{Rgb888, RgbColor};
+use microraster::prelude::Submit;
 use microraster::{
     BoundingSphere, Config, CullMode, DepthBuffer, Error, Frame, FrontFace, Mat4, Mesh, MeshColors,
     SetupTriangle, TriangleId, Vec3,
@@ -457,7 +458,7 @@ pub fn vertex_error(spec: &SceneSpec, mvps: &[Mat4], width: u32, height: u32) ->
         let big = m64.iter().flatten().fold(0.0f64, |a, &v| a.max(v.abs()));
         for (r, row) in m64.iter().enumerate() {
             for (c, &v) in row.iter().enumerate() {
-                let d = (m32.row(r)[c] as f64 - v).abs() / big.max(f64::MIN_POSITIVE);
+                let d = (m32.rows()[r][c] as f64 - v).abs() / big.max(f64::MIN_POSITIVE);
                 e.matrix_rel = e.matrix_rel.max(d);
             }
         }
@@ -573,16 +574,16 @@ fn frame_once<const S: u32, C, T>(
     depth: &mut [T],
 ) -> Result<(), Error>
 where
-    C: microraster::Pixel,
+    C: microraster::PixelFormat,
     T: DepthWord,
     [T]: DepthBuffer,
 {
     let (w, h) = (input.width, input.height);
     let mvps = mvps(input.spec, input.math, w, h);
-    let mut frame = Frame::<S>::new(Config::new(w, h), storage)?;
+    let mut frame = Frame::<S>::with_subpixel_bits(Config::new(w, h), storage)?;
     let mut id = 0u32;
     for (o, m) in input.objects.iter().zip(&mvps) {
-        frame.draw_mesh(&o.mesh(), m, id)?;
+        frame.submit_mesh(&o.mesh(), m, id)?;
         id = id.wrapping_add(o.indices.len() as u32);
     }
     color.fill(clear);

@@ -15,6 +15,7 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565, RgbColor};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
+use microraster::prelude::Submit;
 use microraster::{Config, DepthBuffer, Frame, NoDepth, SetupTriangle, StripDrawer, StripRenderer};
 use microraster_scenes::cubes;
 
@@ -84,7 +85,7 @@ impl DrawTarget for Hasher {
 /// The scene, submitted to one strip.
 fn scene<D: DepthBuffer + ?Sized>(strip: &mut StripRenderer<'_, Rgb565, D>) {
     cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| {
-        strip.draw_mesh(mesh, mvp, id)
+        strip.submit_mesh(mesh, mvp, id).unwrap()
     })
 }
 
@@ -111,7 +112,7 @@ fn from_frame(rows: u32, depth: bool) -> u64 {
     let mut storage = vec![SetupTriangle::EMPTY; 48 * 7];
     let mut frame: Frame = Frame::new(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
     cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| {
-        frame.draw_mesh(mesh, mvp, id).unwrap()
+        frame.submit_mesh(mesh, mvp, id).unwrap()
     });
     let n = (WIDTH * rows) as usize;
     let mut color = vec![Rgb565::BLACK; n];

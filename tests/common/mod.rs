@@ -17,6 +17,7 @@
 
 use microraster::fixed::snap;
 use microraster::pixelcolor::Rgb888;
+use microraster::prelude::*;
 use microraster::{
     Config, CullMode, DepthBuffer, DepthFunc, Frame, NoDepth, SetupTriangle, TriangleId, Vec4,
 };
@@ -217,10 +218,10 @@ pub fn with_frame<const S: u32, R>(
     f: impl FnOnce(&Frame<'_, S>) -> R,
 ) -> R {
     let mut st = storage(tris.len());
-    let mut frame = Frame::<S>::new(config, &mut st).expect("valid frame");
+    let mut frame = Frame::<S>::with_subpixel_bits(config, &mut st).expect("valid frame");
     for (i, t) in tris.iter().enumerate() {
         frame
-            .push_clip_triangle(*t, WHITE3, i as u32)
+            .submit_clip_triangle(*t, WHITE3, i as u32)
             .expect("storage is large enough");
     }
     f(&frame)
@@ -293,8 +294,8 @@ pub fn hit_counts<const S: u32>(config: Config, tris: &[[Vec4; 3]]) -> Vec<u32> 
     let mut counts = vec![0u32; (width * height) as usize];
     let mut st = storage(1);
     for t in tris {
-        let mut frame = Frame::<S>::new(config, &mut st).expect("valid frame");
-        frame.push_clip_triangle(*t, WHITE3, 0).expect("room");
+        let mut frame = Frame::<S>::with_subpixel_bits(config, &mut st).expect("valid frame");
+        frame.submit_clip_triangle(*t, WHITE3, 0).expect("room");
         let Some(r0) = frame.triangles().iter().map(|t| t.rows().0).min() else {
             continue;
         };

@@ -52,7 +52,7 @@ use display::HashDisplay;
 #[cfg(feature = "flat")]
 use microraster::pixelcolor::Rgb888;
 use microraster::pixelcolor::{Rgb565, RgbColor};
-use microraster::{Config, ProcessedVertex, StripDrawer, StripRenderer};
+use microraster::{Config, ProcessedVertex, StripDrawer, StripRenderer, Submit};
 use microraster_scenes::cubes;
 use panic_semihosting as _;
 
@@ -79,7 +79,7 @@ type StripPixel = Flat565;
 struct Flat565(Rgb565);
 
 #[cfg(feature = "flat")]
-impl microraster::Pixel for Flat565 {
+impl microraster::PixelFormat for Flat565 {
     const SHADED: bool = false;
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
@@ -118,7 +118,12 @@ where
     let mut cache = [ProcessedVertex::EMPTY; 8];
     for (i, mvp) in mvps.iter().enumerate() {
         strip.process_vertices(mvp, &cubes::POSITIONS, &mut cache);
-        strip.draw_mesh_processed(&cubes::MESH, (i * cubes::CUBE_INDICES.len()) as u32, &cache);
+        // A strip renderer never runs out of storage: nothing to handle.
+        let _ = strip.submit_processed_mesh(
+            &cubes::MESH,
+            (i * cubes::CUBE_INDICES.len()) as u32,
+            &cache,
+        );
     }
 }
 
@@ -206,8 +211,7 @@ fn main() -> ! {
         let z = &mut DEPTH[..WIDTH as usize];
         #[cfg(feature = "no-depth")]
         let z = &mut microraster::NoDepth;
-        let mut one: StripRenderer<'_, StripPixel, _> =
-            StripRenderer::new(config, HEIGHT / 2, HEIGHT / 2 + 1, row, z).unwrap();
+        let mut one = StripRenderer::new(config, HEIGHT / 2, HEIGHT / 2 + 1, row, z).unwrap();
         submit(&mut one, &mvps);
     }
     let geometry_ticks = (clock.now() - t) * strips;

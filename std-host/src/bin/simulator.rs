@@ -35,6 +35,7 @@ use embedded_graphics_simulator::{
     OutputSettingsBuilder, SimulatorDisplay, SimulatorEvent, Window,
 };
 use microraster::math::radians;
+use microraster::prelude::Submit;
 use microraster::{Config, Mat4, StripDrawer, Vec3};
 use microraster_scenes::cubes;
 use std::collections::HashSet;
@@ -127,7 +128,7 @@ impl Renderer {
         let mut drawer = StripDrawer::new(&mut self.color, &mut self.depth[..], Rgb565::BLACK);
         let drawn = drawer.draw(display, Config::new(WIDTH, HEIGHT), |strip| {
             for (i, mvp) in mvps.iter().enumerate() {
-                strip.draw_mesh(&cubes::MESH, mvp, (i * cubes::CUBE_INDICES.len()) as u32);
+                strip.submit_mesh(&cubes::MESH, mvp, (i * cubes::CUBE_INDICES.len()) as u32);
             }
         });
         // The simulator's display cannot fail, and the buffers fit.
@@ -295,7 +296,7 @@ mod tests {
         let theirs = cubes::mvps(WIDTH, HEIGHT);
         for (a, b) in ours.iter().zip(&theirs) {
             for r in 0..4 {
-                assert_eq!(a.row(r).map(f32::to_bits), b.row(r).map(f32::to_bits));
+                assert_eq!(a.rows()[r].map(f32::to_bits), b.rows()[r].map(f32::to_bits));
             }
         }
     }

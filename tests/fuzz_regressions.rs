@@ -3,17 +3,18 @@
 //! core, each reduced by hand to a minimal input.
 
 use microraster::pixelcolor::Rgb888;
-use microraster::{Config, CullMode, Frame, Pixel, SetupTriangle, TriangleId, Vec4};
+use microraster::prelude::*;
+use microraster::{Config, CullMode, Frame, SetupTriangle, TriangleId, Vec4};
 
 /// The `u16` depth buffer after drawing one clip-space triangle into a
 /// 64x64 frame with colour type `C`.
-fn depth_with<C: Pixel + Copy>(tri: [Vec4; 3], colors: [Rgb888; 3], clear: C) -> Vec<u16> {
+fn depth_with<C: PixelFormat + Copy>(tri: [Vec4; 3], colors: [Rgb888; 3], clear: C) -> Vec<u16> {
     let (w, h) = (64, 64);
     let mut storage = [SetupTriangle::EMPTY; 8];
     let mut config = Config::new(w, h);
     config.cull = CullMode::None;
     let mut frame: Frame = Frame::new(config, &mut storage).unwrap();
-    frame.push_clip_triangle(tri, colors, 0).unwrap();
+    frame.submit_clip_triangle(tri, colors, 0).unwrap();
     let mut color = vec![clear; (w * h) as usize];
     let mut depth = vec![u16::MAX; (w * h) as usize];
     frame.render_rows(0, h, &mut color, &mut depth[..]).unwrap();

@@ -1,0 +1,225 @@
+//! Frame settings and errors: what a caller chooses, and what can go wrong.
+//!
+//! Design note: a [`Config`] is plain data, copied into every frame and
+//! strip renderer. Every fallible call returns an [`Error`] and then has
+//! written nothing: no buffer, no storage slot, no counter. Triangles the
+//! pipeline drops are not errors; they are counted in
+//! [`Stats`](crate::Stats).
+
+use crate::depth::DepthFunc;
+use crate::fixed::MAX_DIMENSION;
+
+/// Which faces to cull.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum CullMode {
+    /// Cull back faces (the default).
+    #[default]
+    Back,
+    /// Cull front faces.
+    Front,
+    /// Cull nothing.
+    None,
+}
+
+/// Which winding, in NDC (y up), is a front face.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FrontFace {
+    /// Counter-clockwise is front (the default, as in OpenGL).
+    #[default]
+    Ccw,
+    /// Clockwise is front.
+    Cw,
+}
+
+/// Per-frame settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Config {
+    /// Frame width in pixels, `1..=16384`.
+    pub width: u32,
+    /// Frame height in pixels, `1..=16384`.
+    pub height: u32,
+    /// Face culling.
+    pub cull: CullMode,
+    /// Front-face winding.
+    pub front_face: FrontFace,
+    /// Depth comparison.
+    pub depth_func: DepthFunc,
+    /// Whether passing fragments write their depth.
+    pub depth_write: bool,
+}
+
+impl Config {
+    /// A `width x height` frame with back-face culling, CCW front faces,
+    /// depth test `Less` and depth writes on.
+    pub const fn new(width: u32, height: u32) -> Self {
+        Config {
+            width,
+            height,
+            cull: CullMode::Back,
+            front_face: FrontFace::Ccw,
+            depth_func: DepthFunc::Less,
+            depth_write: true,
+        }
+    }
+}
+
+/// What went wrong; nothing is written when an error is returned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Error {
+    /// Width or height is 0 or above [`MAX_DIMENSION`].
+    InvalidFrameSize {
+        /// The width asked for.
+        width: u32,
+        /// The height asked for.
+        height: u32,
+    },
+    /// The setup storage cannot hold the triangle (or mesh): nothing of it
+    /// was stored or counted, and the storage was not written.
+    StorageFull {
+        /// The storage's capacity in set-up triangles.
+        capacity: usize,
+        /// Set-up triangles the storage had free before the submission.
+        free: usize,
+        /// Set-up triangles the submission needs in all (a clipped triangle
+        /// can need up to seven).
+        needed: usize,
+    },
+    /// A mesh with more than `u32::MAX` triangles: triangle ids and
+    /// counters are 32-bit per submission.
+    MeshTooLarge {
+        /// The mesh's triangle count.
+        triangles: usize,
+    },
+    /// [`Frame::bin`](crate::Frame::bin) with strips of 0 rows.
+    InvalidStripRows,
+    /// The [`Bins`](crate::Bins) were made for another frame (size, strip
+    /// height or triangle count differ) or before triangles were added.
+    BinsMismatch,
+    /// The row range is empty, reversed or beyond the frame.
+    InvalidRows {
+        /// First row asked for.
+        y0: u32,
+        /// One past the last row asked for.
+        y1: u32,
+        /// The frame height.
+        height: u32,
+    },
+    /// The colour slice does not hold exactly the rows asked for.
+    ColorBufferSize {
+        /// `width * (y1 - y0)`.
+        expected: usize,
+        /// The slice length.
+        actual: usize,
+    },
+    /// Bin storage too small (offsets: strips + 1; items:
+    /// [`Frame::bin_entries`](crate::Frame::bin_entries)).
+    BinStorageSize {
+        /// Entries needed.
+        expected: usize,
+        /// Entries given.
+        actual: usize,
+    },
+    /// The vertex cache holds fewer entries than the mesh has vertices.
+    VertexCacheSize {
+        /// The mesh's vertex count.
+        expected: usize,
+        /// The cache length.
+        actual: usize,
+    },
+    /// The depth slice does not hold exactly the rows asked for.
+    DepthBufferSize {
+        /// `width * (y1 - y0)`.
+        expected: usize,
+        /// The slice length.
+        actual: usize,
+    },
+}
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Error::InvalidFrameSize { width, height } => write!(
+                f,
+                "invalid frame size {width}x{height} (each side must be 1..={MAX_DIMENSION})"
+            ),
+            Error::StorageFull {
+                capacity,
+                free,
+                needed,
+            } => write!(
+                f,
+                "setup storage full: {needed} set-up triangles needed, {free} of {capacity} free"
+            ),
+            Error::MeshTooLarge { triangles } => write!(
+                f,
+                "mesh has {triangles} triangles, more than the {} of one submission",
+                u32::MAX
+            ),
+            Error::InvalidStripRows => write!(f, "strips must have at least one row"),
+            Error::BinsMismatch => write!(f, "the bins were made for another frame"),
+            Error::InvalidRows { y0, y1, height } => {
+                write!(f, "invalid rows {y0}..{y1} for a frame of height {height}")
+            }
+            Error::ColorBufferSize { expected, actual } => {
+                write!(
+                    f,
+                    "colour buffer holds {actual} pixels, expected {expected}"
+                )
+            }
+            Error::BinStorageSize { expected, actual } => {
+                write!(f, "bin storage holds {actual} entries, expected {expected}")
+            }
+            Error::VertexCacheSize { expected, actual } => {
+                write!(
+                    f,
+                    "vertex cache holds {actual} vertices, expected {expected}"
+                )
+            }
+            Error::DepthBufferSize { expected, actual } => {
+                write!(f, "depth buffer holds {actual} values, expected {expected}")
+            }
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+/// Checks a row range and buffer sizes against a frame.
+pub(crate) fn check_rows(
+    config: &Config,
+    y0: u32,
+    y1: u32,
+    color_len: usize,
+    depth_len: Option<usize>,
+) -> Result<(), Error> {
+    let Config { width, height, .. } = *config;
+    if y0 >= y1 || y1 > height {
+        return Err(Error::InvalidRows { y0, y1, height });
+    }
+    let expected = width as usize * (y1 - y0) as usize;
+    if color_len != expected {
+        return Err(Error::ColorBufferSize {
+            expected,
+            actual: color_len,
+        });
+    }
+    if let Some(actual) = depth_len {
+        if actual != expected {
+            return Err(Error::DepthBufferSize { expected, actual });
+        }
+    }
+    Ok(())
+}
+
+/// Checks a frame size.
+pub(crate) fn check_size(config: &Config) -> Result<(), Error> {
+    let ok = |v: u32| (1..=MAX_DIMENSION).contains(&v);
+    if ok(config.width) && ok(config.height) {
+        Ok(())
+    } else {
+        Err(Error::InvalidFrameSize {
+            width: config.width,
+            height: config.height,
+        })
+    }
+}

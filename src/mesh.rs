@@ -1,0 +1,220 @@
+//! Meshes and the vertex stage: object space to processed vertices.
+//!
+//! Design note: a [`Mesh`] borrows the caller's arrays (positions, index
+//! triples, colours) and is never copied. The vertex stage transforms each
+//! position by the model-view-projection matrix (`f32`, fixed order, no
+//! fused multiply-add), computes its outcode and, where no clipping can
+//! touch it, snaps it to window space: a [`ProcessedVertex`] in a cache the
+//! caller provides, so a vertex shared by six triangles is transformed once.
+//! A [`BoundingSphere`] lets a whole object be skipped before any of that.
+
+use crate::clip::{outcode, ClipVertex};
+use crate::math::{Mat4, Vec3, Vec4};
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+
+/// A sphere bounding an object in its own coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BoundingSphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+}
+
+impl BoundingSphere {
+    /// A sphere around every point (centre of the bounding box); `None`
+    /// for no points or a non-finite coordinate.
+    pub fn from_points(points: &[Vec3]) -> Option<BoundingSphere> {
+        let first = points.first()?;
+        let (mut lo, mut hi) = (*first, *first);
+        for p in points {
+            if !p.is_finite() {
+                return None;
+            }
+            lo = Vec3::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z));
+            hi = Vec3::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z));
+        }
+        let center = (lo + hi) * 0.5;
+        let mut r2 = 0.0f32;
+        for p in points {
+            let d = *p - center;
+            r2 = r2.max(d.dot(d));
+        }
+        // A relative margin covers rounding in the distance computation.
+        let radius = crate::math::fx::sqrt(r2) * 1.0001 + f32::MIN_POSITIVE;
+        Some(BoundingSphere { center, radius })
+    }
+
+    /// Whether the sphere lies entirely outside one frustum plane of the
+    /// clip-space transform `mvp`, so that no vertex inside it can be seen.
+    ///
+    /// Conservative for every finite input: the test is exact enough in
+    /// `f64` and is widened by a bound on the rounding of the vertex
+    /// stage itself. A vertex `p` goes to clip space in `f32` as
+    /// `c_r = Σ_j m_rj p_j` (with `p_3 = 1`), three roundings per row, so
+    /// the computed plane value `w ± x` (or `± y`, `± z`) differs from the
+    /// exact one by at most `γ3 (Σ_j (|m_3j| + |m_ij|) |p_j|)` with
+    /// `γ3 = 3u / (1 - 3u) < 4 · 2^-24`, and `|p_j| <= |c_j| + r` inside
+    /// the sphere. The object is culled only if its exact plane value
+    /// stays below minus that bound, so every vertex's computed outcode
+    /// has that plane's bit set and the per-triangle frustum test would
+    /// have culled every triangle anyway. The `f64` evaluation of the
+    /// test itself errs by about `2^-50` of the same sum, covered by the
+    /// bound's factor of 4 (not 3).
+    pub fn outside_frustum(&self, mvp: &Mat4) -> bool {
+        let m = mvp.rows();
+        let c = [
+            self.center.x as f64,
+            self.center.y as f64,
+            self.center.z as f64,
+            1.0,
+        ];
+        let r = self.radius as f64;
+        if !(r >= 0.0 && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
+            return false;
+        }
+        // |p_j| bound inside the sphere.
+        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
+        let gamma = 5.0 / 16_777_216.0;
+        for i in 0..3 {
+            for sign in [1.0f64, -1.0] {
+                // Plane: row3 + sign * row_i (Gribb-Hartmann), exact in f64.
+                let plane: [f64; 4] =
+                    core::array::from_fn(|j| m[3][j] as f64 + sign * m[i][j] as f64);
+                let dist: f64 = (0..4).map(|j| plane[j] * c[j]).sum();
+                let n2: f64 = (0..3).map(|j| plane[j] * plane[j]).sum();
+                let err: f64 = (0..4)
+                    .map(|j| ((m[3][j] as f64).abs() + (m[i][j] as f64).abs()) * p_abs[j])
+                    .sum::<f64>()
+                    * gamma;
+                // Outside when dist + err < -r |n|: compared squared, with
+                // the margin of the square root's rounding.
+                let t = -(dist + err);
+                if t > 0.0 && t * t > r * r * n2 * (1.0 + 1e-9) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// Per-triangle or per-vertex colours of a [`Mesh`].
+#[derive(Clone, Copy, Debug)]
+pub enum MeshColors<'a> {
+    /// One colour for everything.
+    Uniform(Rgb888),
+    /// One colour per triangle (flat shading).
+    PerTriangle(&'a [Rgb888]),
+    /// One colour per vertex (Gouraud shading, perspective-correct).
+    PerVertex(&'a [Rgb888]),
+}
+
+/// An indexed triangle mesh in object space.
+#[derive(Clone, Copy, Debug)]
+pub struct Mesh<'a> {
+    /// Vertex positions.
+    pub positions: &'a [Vec3],
+    /// Triangles as three indices into `positions`.
+    pub indices: &'a [[u32; 3]],
+    /// Colours.
+    pub colors: MeshColors<'a>,
+    /// A bounding sphere for whole-object culling, if known.
+    pub bounds: Option<BoundingSphere>,
+}
+
+impl Mesh<'_> {
+    /// Triangle `i` transformed to clip space by `mvp`, with its colours;
+    /// `None` if an index (or a colour) is out of range.
+    pub fn triangle(&self, i: usize, mvp: &Mat4) -> Option<[ClipVertex; 3]> {
+        let idx = self.indices.get(i)?;
+        let mut verts = [ClipVertex::default(); 3];
+        for k in 0..3 {
+            let vi = idx[k] as usize;
+            let p = self.positions.get(vi)?;
+            let color = match self.colors {
+                MeshColors::Uniform(c) => c,
+                MeshColors::PerTriangle(cs) => *cs.get(i)?,
+                MeshColors::PerVertex(cs) => *cs.get(vi)?,
+            };
+            verts[k] = ClipVertex {
+                pos: mvp.transform_point(*p),
+                color: rgb_f32(color),
+            };
+        }
+        Some(verts)
+    }
+}
+
+/// Outcode bit for a vertex with a NaN or infinite coordinate.
+pub(crate) const NONFINITE: u16 = 1 << 15;
+
+/// A vertex after the vertex stage (see [`Frame::draw_mesh_cached`]):
+/// clip-space position, outcode and, where no clipping can touch it, its
+/// snapped window position.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProcessedVertex {
+    pub(crate) pos: Vec4,
+    pub(crate) inv_w: f32,
+    pub(crate) snap: crate::fixed::SnappedVertex,
+    pub(crate) code: u16,
+    pub(crate) snapped: bool,
+}
+
+impl ProcessedVertex {
+    /// A placeholder to fill a cache with.
+    pub const EMPTY: ProcessedVertex = ProcessedVertex {
+        pos: Vec4::new(0.0, 0.0, 0.0, 0.0),
+        inv_w: 0.0,
+        snap: crate::fixed::SnappedVertex { x: 0, y: 0, z: 0 },
+        code: 0,
+        snapped: false,
+    };
+
+    #[inline]
+    fn new<const S: u32>(pos: Vec4, gx: f32, gy: f32, width: u32, height: u32) -> Self {
+        if !pos.is_finite() {
+            return ProcessedVertex {
+                pos,
+                code: NONFINITE,
+                ..ProcessedVertex::EMPTY
+            };
+        }
+        let code = outcode(pos, gx, gy);
+        let mut v = ProcessedVertex {
+            pos,
+            code,
+            ..ProcessedVertex::EMPTY
+        };
+        if code & outcode::CLIP == 0 && pos.w > 0.0 {
+            v.inv_w = 1.0 / pos.w;
+            if let Some(s) =
+                crate::fixed::snap_inv::<S>(pos.x, pos.y, pos.z, v.inv_w, width, height)
+            {
+                v.snap = s;
+                v.snapped = true;
+            }
+        }
+        v
+    }
+}
+
+pub(crate) fn rgb_f32(c: Rgb888) -> [f32; 3] {
+    [c.r() as f32, c.g() as f32, c.b() as f32]
+}
+
+/// The vertex stage: transform, outcode and (where no clipping can touch
+/// the vertex) snap, pairwise from `positions` into `out`.
+pub(crate) fn process_vertices<const S: u32>(
+    width: u32,
+    height: u32,
+    guard: (f32, f32),
+    mvp: &Mat4,
+    positions: &[Vec3],
+    out: &mut [ProcessedVertex],
+) {
+    let (gx, gy) = guard;
+    for (p, v) in positions.iter().zip(out.iter_mut()) {
+        *v = ProcessedVertex::new::<S>(mvp.transform_point(*p), gx, gy, width, height);
+    }
+}

@@ -1,0 +1,573 @@
+//! Submission: one path from clip-space triangles (or meshes) to set-up
+//! triangles, shared by [`Frame`](crate::Frame) and
+//! [`StripRenderer`](crate::StripRenderer).
+//!
+//! Design note: both types implement [`Submit`], whose provided methods are
+//! the only submission code in the crate. A submission runs
+//! `object cull -> (vertex stage) -> outcodes -> frustum cull -> strip skip
+//! -> clip -> snap -> setup` and hands every set-up piece to the receiver's
+//! sink: a [`Frame`](crate::Frame) stores it, a
+//! [`StripRenderer`](crate::StripRenderer) draws it into its strip at once.
+//!
+//! All or nothing: before a submission writes anything it knows it fits.
+//! A triangle yields at most [`MAX_PIECES`] set-up pieces (one unless it is
+//! clipped); when the free room of a frame's storage is below that bound
+//! the submission is first run without storing, to count its pieces, and
+//! refused with [`Error::StorageFull`] (the true count in it) if they do not
+//! fit. So a failed submission writes no storage slot and no counter.
+
+use crate::clip::{clip_triangle, outcode, ClipVertex};
+use crate::config::Error;
+use crate::fixed::{snap, SnappedVertex};
+use crate::math::{Mat4, Vec3, Vec4};
+use crate::mesh::{process_vertices, rgb_f32, Mesh, MeshColors, ProcessedVertex, NONFINITE};
+use crate::setup::{inv_w3, setup, setup_geometry, triangulate, Rejected, SetupTriangle};
+use crate::stats::Stats;
+use embedded_graphics_core::pixelcolor::Rgb888;
+
+/// The most set-up pieces one submitted triangle can become (a triangle
+/// clipped by near, far and four guard-band planes is a polygon of at most
+/// nine vertices: seven fan pieces).
+pub const MAX_PIECES: usize = 7;
+
+/// Internals of [`Submit`]: not part of the API.
+#[doc(hidden)]
+pub mod __private {
+    use crate::config::Config;
+    use crate::math::Vec4;
+    use crate::setup::SetupTriangle;
+    use crate::stats::Stats;
+
+    pub use crate::frame::Store;
+    pub use crate::strip_renderer::StripSink;
+
+    /// What a submission needs to know about its receiver that does not change
+    /// while it runs.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Stage {
+        /// The frame's settings.
+        pub(crate) config: Config,
+        /// The guard band in NDC units (see [`crate::fixed::guard_band_ndc`]).
+        pub(crate) guard: (f32, f32),
+        /// For a strip renderer not covering the whole frame: NDC y above which
+        /// (`.0`) and below which (`.1`) a vertex lies beyond the strip, with
+        /// a quarter-pixel margin. `None` skips nothing.
+        pub(crate) slab: Option<(f32, f32)>,
+    }
+
+    impl Stage {
+        pub(crate) fn new<const S: u32>(config: Config, slab: Option<(f32, f32)>) -> Stage {
+            Stage {
+                config,
+                guard: crate::fixed::guard_band_ndc::<S>(config.width, config.height),
+                slab,
+            }
+        }
+
+        /// Whether a triangle (in front of the eye, inside no frustum plane's
+        /// outside) lies wholly above or below the strip: then no pixel centre
+        /// of the strip can be covered. The quarter-pixel margin dwarfs float
+        /// rounding and snapping (half a subpixel), so this never decides
+        /// coverage.
+        #[inline]
+        pub(crate) fn outside_strip(&self, p: [Vec4; 3]) -> bool {
+            match self.slab {
+                None => false,
+                Some((top, bottom)) => {
+                    p.iter().all(|v| v.w > 0.0)
+                        && (p.iter().all(|v| v.y > v.w * top)
+                            || p.iter().all(|v| v.y < v.w * bottom))
+                }
+            }
+        }
+    }
+
+    /// Where set-up pieces go.
+    pub trait Sink {
+        /// Pieces it can still take (`usize::MAX` for no limit).
+        fn room(&self) -> usize;
+        /// Its total capacity, for [`Error::StorageFull`](crate::Error).
+        fn capacity(&self) -> usize;
+        /// Takes one piece; called only while `room() > 0`.
+        fn take(&mut self, t: &SetupTriangle);
+    }
+
+    /// A receiver's parts, borrowed for one submission.
+    #[derive(Debug)]
+    pub struct Parts<'a, K: ?Sized> {
+        pub(crate) stage: &'a Stage,
+        pub(crate) stats: &'a mut Stats,
+        pub(crate) sink: &'a mut K,
+    }
+}
+
+pub(crate) use __private::Stage;
+use __private::{Parts, Sink};
+
+/// Counts pieces instead of taking them: the dry run of a submission that
+/// might not fit.
+struct Counter(usize);
+
+impl Sink for Counter {
+    fn room(&self) -> usize {
+        usize::MAX
+    }
+    fn capacity(&self) -> usize {
+        usize::MAX
+    }
+    fn take(&mut self, _: &SetupTriangle) {
+        self.0 = self.0.saturating_add(1);
+    }
+}
+
+/// Submitting triangles and meshes: implemented by
+/// [`Frame`](crate::Frame), which stores the set-up triangles to render
+/// any rows later, and by [`StripRenderer`](crate::StripRenderer), which
+/// draws them into its strip at once. `S` is the receiver's subpixel
+/// precision.
+///
+/// Every method is all or nothing: on an error nothing of the submission
+/// is stored, drawn or counted. Triangle ids (see
+/// [`TriangleId`](crate::TriangleId)) are the caller's: a mesh's triangle
+/// `i` gets `first_id + i` (wrapping).
+pub trait Submit<const S: u32 = 8> {
+    /// The receiver's sink (internal).
+    #[doc(hidden)]
+    type Sink: Sink;
+
+    /// The receiver's parts (internal).
+    #[doc(hidden)]
+    fn parts(&mut self) -> Parts<'_, Self::Sink>;
+
+    /// The receiver's stage (internal).
+    #[doc(hidden)]
+    fn stage(&self) -> &Stage;
+
+    /// Submits one clip-space triangle (positions and colours).
+    fn submit_triangle(&mut self, tri: [ClipVertex; 3], id: u32) -> Result<(), Error> {
+        let job = TriangleJob { tri, id };
+        run_job::<S, _, _>(self.parts(), &job)
+    }
+
+    /// Submits one clip-space triangle with a colour per vertex.
+    fn submit_clip_triangle(
+        &mut self,
+        pos: [Vec4; 3],
+        color: [Rgb888; 3],
+        id: u32,
+    ) -> Result<(), Error> {
+        let tri = core::array::from_fn(|k| ClipVertex {
+            pos: pos[k],
+            color: rgb_f32(color[k]),
+        });
+        self.submit_triangle(tri, id)
+    }
+
+    /// Submits every triangle of `mesh`, transformed by `mvp` (object to
+    /// clip space), one triangle at a time. The bounding sphere, if given,
+    /// is tested first: an object entirely outside the frustum is counted
+    /// in [`Stats::culled_object`] without transforming a vertex.
+    fn submit_mesh(&mut self, mesh: &Mesh<'_>, mvp: &Mat4, first_id: u32) -> Result<(), Error> {
+        let n = check_mesh_len(mesh.indices.len())?;
+        let mut parts = self.parts();
+        if culled_object(&mut parts, mesh, mvp, n) {
+            return Ok(());
+        }
+        let job = MeshJob {
+            mesh,
+            mvp,
+            first_id,
+        };
+        run_job::<S, _, _>(parts, &job)
+    }
+
+    /// Like [`Submit::submit_mesh`], with every vertex transformed,
+    /// outcoded and snapped once instead of once per triangle that uses it:
+    /// the fast path for indexed meshes. `cache` is scratch space of at
+    /// least `mesh.positions.len()` entries. The result is identical.
+    fn submit_mesh_cached(
+        &mut self,
+        mesh: &Mesh<'_>,
+        mvp: &Mat4,
+        first_id: u32,
+        cache: &mut [ProcessedVertex],
+    ) -> Result<(), Error> {
+        let n = check_mesh_len(mesh.indices.len())?;
+        let Some(cache) = cache.get_mut(..mesh.positions.len()) else {
+            return Err(Error::VertexCacheSize {
+                expected: mesh.positions.len(),
+                actual: cache.len(),
+            });
+        };
+        if culled_object(&mut self.parts(), mesh, mvp, n) {
+            return Ok(());
+        }
+        self.process_vertices(mvp, mesh.positions, cache);
+        self.submit_processed_mesh(mesh, first_id, cache)
+    }
+
+    /// The vertex stage of [`Submit::submit_mesh_cached`] alone: transforms,
+    /// outcodes and snaps `positions` into `out` (pairwise; extra entries of
+    /// either are left alone). The result depends only on the frame's
+    /// configuration, so chunks of one mesh can be processed in parallel,
+    /// and a strip renderer can process a mesh once per frame and draw it
+    /// into every strip.
+    fn process_vertices(&self, mvp: &Mat4, positions: &[Vec3], out: &mut [ProcessedVertex]) {
+        let st = self.stage();
+        process_vertices::<S>(
+            st.config.width,
+            st.config.height,
+            st.guard,
+            mvp,
+            positions,
+            out,
+        );
+    }
+
+    /// The triangle stage of [`Submit::submit_mesh_cached`]: submits the
+    /// triangles of `mesh` whose vertices `cache` holds, processed by
+    /// [`Submit::process_vertices`] for a frame of this configuration
+    /// (entry `i` for `mesh.positions[i]`; a triangle indexing past the
+    /// cache is counted in [`Stats::rejected_index`]; `mesh.bounds` is not
+    /// tested here).
+    fn submit_processed_mesh(
+        &mut self,
+        mesh: &Mesh<'_>,
+        first_id: u32,
+        cache: &[ProcessedVertex],
+    ) -> Result<(), Error> {
+        check_mesh_len(mesh.indices.len())?;
+        let job = ProcessedJob {
+            mesh,
+            first_id,
+            cache,
+        };
+        run_job::<S, _, _>(self.parts(), &job)
+    }
+}
+
+/// Triangle counts per submission fit `u32` (ids are 32-bit).
+fn check_mesh_len(n: usize) -> Result<u64, Error> {
+    if n as u64 > u32::MAX as u64 {
+        Err(Error::MeshTooLarge { triangles: n })
+    } else {
+        Ok(n as u64)
+    }
+}
+
+/// The bounding-sphere test of a mesh: counts the whole mesh and returns
+/// `true` if it is culled.
+fn culled_object<K: Sink + ?Sized>(
+    parts: &mut Parts<'_, K>,
+    mesh: &Mesh<'_>,
+    mvp: &Mat4,
+    n: u64,
+) -> bool {
+    match mesh.bounds {
+        Some(b) if b.outside_frustum(mvp) => {
+            *parts.stats += Stats {
+                submitted: n,
+                culled_object: n,
+                ..Stats::default()
+            };
+            true
+        }
+        _ => false,
+    }
+}
+
+/// One submission, run once to count (if it might not fit) and once to
+/// deliver.
+trait Job {
+    /// An upper bound on the pieces it yields.
+    fn bound(&self, stage: &Stage) -> usize;
+    /// Runs it, counting into `stats` and handing pieces to `sink`.
+    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K);
+}
+
+fn run_job<const S: u32, K: Sink + ?Sized, J: Job>(
+    parts: Parts<'_, K>,
+    job: &J,
+) -> Result<(), Error> {
+    let room = parts.sink.room();
+    if job.bound(parts.stage) > room {
+        let mut count = Counter(0);
+        job.run::<S, _>(parts.stage, &mut Stats::default(), &mut count);
+        if count.0 > room {
+            return Err(Error::StorageFull {
+                capacity: parts.sink.capacity(),
+                free: room,
+                needed: count.0,
+            });
+        }
+    }
+    let mut stats = Stats::default();
+    job.run::<S, _>(parts.stage, &mut stats, parts.sink);
+    *parts.stats += stats;
+    Ok(())
+}
+
+struct TriangleJob {
+    tri: [ClipVertex; 3],
+    id: u32,
+}
+
+impl Job for TriangleJob {
+    fn bound(&self, _: &Stage) -> usize {
+        MAX_PIECES
+    }
+    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
+        stats.submitted += 1;
+        process::<S, K>(stage, &self.tri, self.id, stats, sink);
+    }
+}
+
+struct MeshJob<'m> {
+    mesh: &'m Mesh<'m>,
+    mvp: &'m Mat4,
+    first_id: u32,
+}
+
+impl Job for MeshJob<'_> {
+    fn bound(&self, _: &Stage) -> usize {
+        self.mesh.indices.len().saturating_mul(MAX_PIECES)
+    }
+    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
+        for i in 0..self.mesh.indices.len() {
+            stats.submitted += 1;
+            match self.mesh.triangle(i, self.mvp) {
+                Some(tri) => {
+                    let id = self.first_id.wrapping_add(i as u32);
+                    process::<S, K>(stage, &tri, id, stats, sink);
+                }
+                None => stats.rejected_index += 1,
+            }
+        }
+    }
+}
+
+struct ProcessedJob<'m> {
+    mesh: &'m Mesh<'m>,
+    first_id: u32,
+    cache: &'m [ProcessedVertex],
+}
+
+impl Job for ProcessedJob<'_> {
+    /// One piece per triangle that needs no clipping, seven for the rest
+    /// (a cheap pass over the outcodes).
+    fn bound(&self, _: &Stage) -> usize {
+        let code = |k: u32| self.cache.get(k as usize).map_or(0, |v| v.code);
+        self.mesh.indices.iter().fold(0usize, |n, idx| {
+            let or = code(idx[0]) | code(idx[1]) | code(idx[2]);
+            n.saturating_add(if or & outcode::CLIP != 0 {
+                MAX_PIECES
+            } else {
+                1
+            })
+        })
+    }
+
+    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
+        let (mesh, cache) = (self.mesh, self.cache);
+        let c = &stage.config;
+        // Colour lists as long as the mesh need no check per triangle.
+        let colors_complete = match mesh.colors {
+            MeshColors::Uniform(_) => true,
+            MeshColors::PerTriangle(cs) => cs.len() >= mesh.indices.len(),
+            MeshColors::PerVertex(cs) => cs.len() >= cache.len(),
+        };
+        for (i, idx) in mesh.indices.iter().enumerate() {
+            let id = self.first_id.wrapping_add(i as u32);
+            stats.submitted += 1;
+            let (Some(a), Some(b), Some(d)) = (
+                cache.get(idx[0] as usize),
+                cache.get(idx[1] as usize),
+                cache.get(idx[2] as usize),
+            ) else {
+                stats.rejected_index += 1;
+                continue;
+            };
+            // A missing colour counts as a bad index, as in `submit_mesh`.
+            let colors_ok = colors_complete
+                || match mesh.colors {
+                    MeshColors::Uniform(_) => true,
+                    MeshColors::PerTriangle(cs) => i < cs.len(),
+                    MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
+                };
+            if !colors_ok {
+                stats.rejected_index += 1;
+                continue;
+            }
+            let color = |k: usize| -> [f32; 3] {
+                rgb_f32(match mesh.colors {
+                    MeshColors::Uniform(c) => c,
+                    MeshColors::PerTriangle(cs) => cs.get(i).copied().unwrap_or_default(),
+                    MeshColors::PerVertex(cs) => {
+                        cs.get(idx[k] as usize).copied().unwrap_or_default()
+                    }
+                })
+            };
+            let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
+            if or & NONFINITE != 0 {
+                stats.rejected_nonfinite += 1;
+                continue;
+            }
+            if and & outcode::FRUSTUM != 0 {
+                stats.culled_frustum += 1;
+                continue;
+            }
+            if stage.outside_strip([a.pos, b.pos, d.pos]) {
+                stats.outside_strip += 1;
+                continue;
+            }
+            if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
+                // Fast path: vertices already snapped.
+                match setup_geometry::<S>(
+                    &[a.snap, b.snap, d.snap],
+                    c.width,
+                    c.height,
+                    c.cull,
+                    c.front_face,
+                ) {
+                    Ok(g) => {
+                        let t = g.finish(
+                            [a.inv_w, b.inv_w, d.inv_w],
+                            [color(0), color(1), color(2)],
+                            id,
+                        );
+                        sink.take(&t);
+                        stats.stored += 1;
+                    }
+                    Err(r) => count_rejected(stats, r),
+                }
+                continue;
+            }
+            let v = [a, b, d];
+            let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
+                pos: v[k].pos,
+                color: color(k),
+            });
+            process_finite::<S, K>(stage, &tri, [a.code, b.code, d.code], id, stats, sink);
+        }
+    }
+}
+
+fn count_rejected(stats: &mut Stats, r: Rejected) {
+    match r {
+        Rejected::Backface => stats.culled_backface += 1,
+        Rejected::Degenerate => stats.culled_degenerate += 1,
+        Rejected::Offscreen => stats.culled_frustum += 1,
+    }
+}
+
+/// Runs one submitted triangle through cull, clip and setup, handing each
+/// set-up piece (at most [`MAX_PIECES`]) to `sink` and counting it in
+/// `stats` (not `submitted`: the caller counts that).
+fn process<const S: u32, K: Sink + ?Sized>(
+    stage: &Stage,
+    tri: &[ClipVertex; 3],
+    id: u32,
+    stats: &mut Stats,
+    sink: &mut K,
+) {
+    if !tri
+        .iter()
+        .all(|v| v.pos.is_finite() && v.color.iter().all(|c| c.is_finite()))
+    {
+        stats.rejected_nonfinite += 1;
+        return;
+    }
+    let (gx, gy) = stage.guard;
+    let codes = tri.map(|v| outcode(v.pos, gx, gy));
+    if codes[0] & codes[1] & codes[2] & outcode::FRUSTUM != 0 {
+        stats.culled_frustum += 1;
+        return;
+    }
+    if stage.outside_strip(tri.map(|v| v.pos)) {
+        stats.outside_strip += 1;
+        return;
+    }
+    process_finite::<S, K>(stage, tri, codes, id, stats, sink);
+}
+
+/// [`process`] after the finiteness, frustum and strip tests.
+fn process_finite<const S: u32, K: Sink + ?Sized>(
+    stage: &Stage,
+    tri: &[ClipVertex; 3],
+    codes: [u16; 3],
+    id: u32,
+    stats: &mut Stats,
+    sink: &mut K,
+) {
+    let c = &stage.config;
+    let (gx, gy) = stage.guard;
+    let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
+    if crossing == 0 {
+        match setup::<S>(tri, c.width, c.height, c.cull, c.front_face, id) {
+            Ok(t) => {
+                sink.take(&t);
+                stats.stored += 1;
+            }
+            Err(r) => count_rejected(stats, r),
+        }
+        return;
+    }
+    stats.clipped += 1;
+    let poly = clip_triangle(tri, crossing, gx, gy);
+    if poly.len() < 3 {
+        stats.culled_frustum += 1;
+        return;
+    }
+    // Snap the polygon's vertices once; split it into triangles that all
+    // wind the same way (a fan, unless snapping made the polygon slightly
+    // non-convex, see `setup::triangulate`); cull and set up each piece.
+    let mut snapped: heapless::Vec<Option<SnappedVertex>, 9> = heapless::Vec::new();
+    for v in &poly {
+        let p = v.pos;
+        let _ = snapped.push(snap::<S>(p.x, p.y, p.z, p.w, c.width, c.height));
+    }
+    let mut first_reason = None;
+    let mut stored = 0;
+    for [a, b, d] in triangulate(&snapped) {
+        let (a, b, d) = (a as usize, b as usize, d as usize);
+        let (Some(sa), Some(sb), Some(sd)) = (snapped[a], snapped[b], snapped[d]) else {
+            // A finite vertex that cannot be placed: clipping left it at
+            // (or, in f32, indistinguishably near) the homogeneous origin.
+            first_reason.get_or_insert(Rejected::Degenerate);
+            continue;
+        };
+        match setup_geometry::<S>(&[sa, sb, sd], c.width, c.height, c.cull, c.front_face) {
+            Ok(g) => {
+                let (pa, pb, pd) = (&poly[a], &poly[b], &poly[d]);
+                let t = g.finish(
+                    inv_w3([pa.pos.w, pb.pos.w, pd.pos.w]),
+                    [pa.color, pb.color, pd.color],
+                    id,
+                );
+                sink.take(&t);
+                stored += 1;
+                stats.stored += 1;
+            }
+            Err(r) => {
+                first_reason.get_or_insert(r);
+            }
+        }
+    }
+    if stored == 0 {
+        count_rejected(stats, first_reason.unwrap_or(Rejected::Degenerate));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn meshes_beyond_u32_triangles_are_refused() {
+        assert_eq!(check_mesh_len(u32::MAX as usize), Ok(u32::MAX as u64));
+        if usize::BITS > 32 {
+            let n = (u32::MAX as u64 + 1) as usize;
+            assert_eq!(check_mesh_len(n), Err(Error::MeshTooLarge { triangles: n }));
+        }
+    }
+}

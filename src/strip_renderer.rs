@@ -1,0 +1,251 @@
+//! Immediate strip rendering: no setup storage at all.
+//!
+//! Design note: [`Frame`](crate::Frame) sets every triangle up once and
+//! keeps the result, which costs about a hundred bytes a triangle. Where RAM
+//! is scarcer than cycles (a microcontroller drawing through a 16-row
+//! buffer) [`StripRenderer`] instead runs each submitted triangle through
+//! the same pipeline ([`Submit`]: transform, cull, clip, setup) and draws it
+//! straight into the one strip it holds. The caller submits the scene once
+//! per strip. The pixels are bit-identical to
+//! [`Frame::render_rows`](crate::Frame::render_rows) for the same rows: it
+//! is the same code in the same order, only without the store. Triangles
+//! wholly above or below the strip are skipped before clipping and setup
+//! (counted in [`Stats::outside_strip`]), so each strip pays the full
+//! pipeline only for the triangles that reach it.
+
+use crate::color::PixelFormat;
+use crate::config::{check_rows, check_size, Config, Error};
+use crate::depth::DepthBuffer;
+use crate::fixed::check_subpixel_bits;
+use crate::pipeline::{
+    __private::{Parts, Sink},
+    Stage, Submit,
+};
+use crate::raster::{draw, Strip};
+use crate::setup::SetupTriangle;
+use crate::stats::{RenderStats, Stats};
+
+/// A strip renderer's sink: its rows, and the pixels written so far.
+pub struct StripSink<'b, C, D: ?Sized, const S: u32> {
+    strip: Strip<'b, C, D>,
+    render: RenderStats,
+}
+
+impl<C, D: ?Sized, const S: u32> core::fmt::Debug for StripSink<'_, C, D, S> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("StripSink")
+            .field("rows", &(self.strip.y0..self.strip.y1))
+            .field("render", &self.render)
+            .finish()
+    }
+}
+
+impl<C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Sink for StripSink<'_, C, D, S> {
+    fn room(&self) -> usize {
+        usize::MAX
+    }
+    fn capacity(&self) -> usize {
+        usize::MAX
+    }
+    #[inline]
+    fn take(&mut self, t: &SetupTriangle) {
+        self.render.pixels_written += draw::<S, C, D>(t, &mut self.strip) as u64;
+    }
+}
+
+/// Draws triangles straight into rows `y0..y1` of a frame, at `S` subpixel
+/// bits, without storing them. Submit with [`Submit`]'s methods; they
+/// never return [`Error::StorageFull`].
+///
+/// ```
+/// use microraster::prelude::*;
+/// use microraster::{Config, CullMode, NoDepth, StripRenderer, Vec4};
+///
+/// let mut config = Config::new(16, 16);
+/// config.cull = CullMode::None;
+/// let mut rows = [Rgb888::BLACK; 16 * 4];
+/// let mut no_depth = NoDepth;
+/// // Rows 8..12 of a 16x16 frame, no depth buffer.
+/// let mut strip = StripRenderer::new(config, 8, 12, &mut rows, &mut no_depth).unwrap();
+/// let v = |x, y| Vec4::new(x, y, 0.0, 1.0);
+/// strip
+///     .submit_clip_triangle([v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)], [Rgb888::RED; 3], 0)
+///     .unwrap();
+/// assert!(strip.render_stats().pixels_written > 0);
+/// ```
+pub struct StripRenderer<'b, C, D: ?Sized, const S: u32 = 8> {
+    stage: Stage,
+    sink: StripSink<'b, C, D, S>,
+    stats: Stats,
+}
+
+impl<C, D: ?Sized, const S: u32> core::fmt::Debug for StripRenderer<'_, C, D, S> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("StripRenderer")
+            .field("config", &self.stage.config)
+            .field("sink", &self.sink)
+            .field("stats", &self.stats)
+            .finish()
+    }
+}
+
+impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized> StripRenderer<'b, C, D> {
+    /// A renderer at the default 8 subpixel bits for rows `y0..y1` of a
+    /// frame, drawing into `color` and `depth`, which hold exactly those
+    /// rows. Buffers are drawn over, not cleared.
+    pub fn new(
+        config: Config,
+        y0: u32,
+        y1: u32,
+        color: &'b mut [C],
+        depth: &'b mut D,
+    ) -> Result<Self, Error> {
+        StripRenderer::with_subpixel_bits(config, y0, y1, color, depth)
+    }
+}
+
+impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b, C, D, S> {
+    /// [`StripRenderer::new`] at `S` subpixel bits (4 or 8; anything else
+    /// does not compile).
+    pub fn with_subpixel_bits(
+        config: Config,
+        y0: u32,
+        y1: u32,
+        color: &'b mut [C],
+        depth: &'b mut D,
+    ) -> Result<Self, Error> {
+        const { check_subpixel_bits::<S>() };
+        check_size(&config)?;
+        check_rows(&config, y0, y1, color.len(), depth.depth_len())?;
+        let whole = y0 == 0 && y1 == config.height;
+        let h = config.height as f32;
+        let slab = (!whole).then(|| {
+            (
+                1.0 - 2.0 * (y0 as f32 + 0.25) / h,
+                1.0 - 2.0 * (y1 as f32 - 0.25) / h,
+            )
+        });
+        Ok(StripRenderer {
+            stage: Stage::new::<S>(config, slab),
+            sink: StripSink {
+                strip: Strip {
+                    width: config.width as usize,
+                    y0,
+                    y1,
+                    color,
+                    depth,
+                    depth_func: config.depth_func,
+                    depth_write: config.depth_write,
+                },
+                render: RenderStats::default(),
+            },
+            stats: Stats::default(),
+        })
+    }
+
+    /// The frame's settings.
+    pub fn config(&self) -> &Config {
+        &self.stage.config
+    }
+
+    /// Counters of the triangles submitted so far (to this strip).
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Pixels written so far.
+    pub fn render_stats(&self) -> RenderStats {
+        self.sink.render
+    }
+}
+
+impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Submit<S>
+    for StripRenderer<'b, C, D, S>
+{
+    type Sink = StripSink<'b, C, D, S>;
+
+    fn parts(&mut self) -> Parts<'_, Self::Sink> {
+        Parts {
+            stage: &self.stage,
+            stats: &mut self.stats,
+            sink: &mut self.sink,
+        }
+    }
+
+    fn stage(&self) -> &Stage {
+        &self.stage
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::TriangleId;
+    use crate::frame::Frame;
+    use crate::math::{Mat4, Vec3};
+    use crate::mesh::{Mesh, MeshColors, ProcessedVertex};
+    use embedded_graphics_core::pixelcolor::Rgb888;
+
+    #[test]
+    fn processed_mesh_through_strips_equals_the_frame() {
+        let positions: [Vec3; 8] = core::array::from_fn(|i| {
+            let b = |k: usize| if i >> k & 1 == 1 { 1.0 } else { -1.0 };
+            Vec3::new(b(0), b(1), b(2))
+        });
+        let indices = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let colors: [Rgb888; 8] = core::array::from_fn(|i| Rgb888::new(30 * i as u8, 200, 90));
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: MeshColors::PerVertex(&colors),
+            bounds: None,
+        };
+        let mut config = Config::new(40, 30);
+        config.cull = crate::CullMode::None;
+        for angle in [0.3f32, 1.1, 2.6] {
+            let mvp = Mat4::perspective(1.0, 40.0 / 30.0, 0.5, 9.0)
+                * Mat4::translation(Vec3::new(0.2, -0.1, -3.5))
+                * Mat4::rotation_y(angle)
+                * Mat4::rotation_x(0.4);
+            let mut st = [SetupTriangle::EMPTY; 64];
+            let mut frame: Frame = Frame::new(config, &mut st).unwrap();
+            frame.submit_mesh(&mesh, &mvp, 3).unwrap();
+            let mut whole = [Rgb888::new(0, 0, 0); 40 * 30];
+            let mut wz = [u16::MAX; 40 * 30];
+            frame.render_rows(0, 30, &mut whole, &mut wz[..]).unwrap();
+            let mut ids = [TriangleId(0); 40 * 30];
+            frame
+                .render_rows(0, 30, &mut ids, &mut crate::NoDepth)
+                .unwrap();
+            let mut cache = [ProcessedVertex::EMPTY; 8];
+            for rows in [1u32, 4, 7, 30] {
+                for y0 in (0..30).step_by(rows as usize) {
+                    let y1 = (y0 + rows).min(30);
+                    let n = (40 * (y1 - y0)) as usize;
+                    let r = (40 * y0) as usize..(40 * y0) as usize + n;
+                    let mut c = [Rgb888::new(0, 0, 0); 40 * 30];
+                    let mut z = [u16::MAX; 40 * 30];
+                    let mut s =
+                        StripRenderer::new(config, y0, y1, &mut c[..n], &mut z[..n]).unwrap();
+                    s.process_vertices(&mvp, &positions, &mut cache);
+                    s.submit_processed_mesh(&mesh, 3, &cache).unwrap();
+                    assert_eq!(&c[..n], &whole[r.clone()], "rows {y0}..{y1}");
+                    assert_eq!(&z[..n], &wz[r], "rows {y0}..{y1}");
+                }
+            }
+        }
+    }
+}
