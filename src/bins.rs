@@ -1,7 +1,7 @@
 //! Binning: which stored triangles reach which strip.
 //!
-//! Design note: after a frame's triangles are set up, [`Frame::bin`]
-//! (crate::Frame::bin) sorts their indices into one list per strip of
+//! Design note: after a frame's triangles are set up,
+//! [`Frame::bin`](crate::Frame::bin) sorts their indices into one list per strip of
 //! `strip_rows` rows, in caller storage (`offsets`: strips + 1 entries,
 //! `items`: one per (triangle, strip it touches)), with a counting sort
 //! that needs no scratch. Each list keeps submission order, so rendering a

@@ -2,11 +2,14 @@
 //!
 //! Design note: the rasterizer computes a fragment's colour as [`Rgb888`]
 //! (8 bits a channel) and hands it with the triangle's index to
-//! [`PixelFormat::from_fragment`]. Colour types convert with embedded-graphics'
-//! own `From<Rgb888>` conversions: `Rgb565` keeps the top 5/6/5 bits of each
-//! channel, `Gray8` takes the luma, `BinaryColor` is on when the luma is at
-//! least half. [`TriangleId`] ignores colour ([`PixelFormat::SHADED`] is `false`,
-//! so no colour is computed) and records which triangle won each pixel.
+//! [`PixelFormat::from_fragment`]. Colour types convert with
+//! embedded-graphics' own `From<Rgb888>` conversions, which round each
+//! channel to the nearest value of the narrower range: `Rgb565` is
+//! `round(v * 31 / 255)`, `round(v * 63 / 255)`, `round(v * 31 / 255)`;
+//! `Gray8` is the BT.601 luma; `BinaryColor` is on when that luma is at
+//! least 128. [`TriangleId`] ignores colour ([`PixelFormat::SHADED`] is
+//! `false`, so no colour is computed) and records which triangle won each
+//! pixel.
 
 use embedded_graphics_core::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888};
 

@@ -3,7 +3,7 @@
 //!
 //! Design note: a display driver wants whole rectangles of pixels, and the
 //! firmware has RAM for a few rows, not a frame. [`StripDrawer`] holds the
-//! caller's strip buffers (colour, and depth or [`NoDepth`](crate::NoDepth))
+//! caller's strip buffers (colour, and depth or [`NoDepth`])
 //! and walks a frame top to bottom: for each strip it clears the buffers,
 //! draws the rows into them, and pushes them to the target with **one**
 //! [`DrawTarget::fill_contiguous`] over the strip's rectangle (a display

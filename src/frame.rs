@@ -1,7 +1,7 @@
 //! The frame: triangles in, set-up triangles stored, any rows out.
 //!
 //! Design note: a [`Frame`] owns nothing. It borrows the caller's setup
-//! storage (`&mut [SetupTriangle]`) and takes triangles through [`Submit`]
+//! storage (`&mut [SetupTriangle]`) and takes triangles through [`Submit`](crate::Submit)
 //! (clip-space triangles, or meshes with a matrix). [`Frame::render_rows`]
 //! then draws rows `y0..y1` into colour and depth buffers that hold exactly
 //! those rows; it takes `&self`, so threads can render disjoint strips of
@@ -20,10 +20,7 @@ use crate::color::PixelFormat;
 use crate::config::{check_rows, check_size, Config, Error};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
-use crate::pipeline::{
-    __private::{Parts, Sink},
-    Stage, Submit,
-};
+use crate::pipeline::{__private::Sink, impl_submit, Stage};
 use crate::raster::{draw, Strip};
 use crate::setup::SetupTriangle;
 use crate::stats::{RenderStats, Stats};
@@ -251,21 +248,7 @@ impl<'s, const S: u32> Frame<'s, S> {
     }
 }
 
-impl<'s, const S: u32> Submit<S> for Frame<'s, S> {
-    type Sink = Store<'s>;
-
-    fn parts(&mut self) -> Parts<'_, Store<'s>> {
-        Parts {
-            stage: &self.stage,
-            stats: &mut self.stats,
-            sink: &mut self.store,
-        }
-    }
-
-    fn stage(&self) -> &Stage {
-        &self.stage
-    }
-}
+impl_submit!(['s, const S: u32] Frame<'s, S>, Store<'s>, store);
 
 #[cfg(test)]
 mod tests {
@@ -275,6 +258,7 @@ mod tests {
     use crate::depth::NoDepth;
     use crate::math::{Mat4, Vec3, Vec4};
     use crate::mesh::{Mesh, MeshColors, ProcessedVertex};
+    use crate::pipeline::Submit;
     use embedded_graphics_core::pixelcolor::Rgb888;
 
     /// A deterministic pseudo-random scene of overlapping triangles.

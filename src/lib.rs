@@ -47,7 +47,9 @@
 //!
 //! ## From `Vec3` to pixel: the stages and their files
 //!
-//! The modules are listed here, and declared below, in pipeline order:
+//! The modules are listed here, and declared, in pipeline order; each one's
+//! page opens with its design note. Everything a program uses is also
+//! re-exported at the crate root.
 //!
 //! | stage | file | what happens |
 //! |---|---|---|
@@ -70,21 +72,23 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs, missing_debug_implementations)]
 
-mod config;
+// The stages, in the order a triangle takes. Each module opens with its
+// design note (shown by `cargo doc`); the items are re-exported below.
+pub mod config;
 pub mod math;
-mod mesh;
-mod pipeline;
+pub mod mesh;
+pub mod pipeline;
 pub mod clip;
 pub mod fixed;
-mod setup;
-mod stats;
-mod bins;
-mod frame;
-mod strip_renderer;
-mod raster;
-mod depth;
-mod color;
-mod draw_target;
+pub mod setup;
+pub mod stats;
+pub mod bins;
+pub mod frame;
+pub mod strip_renderer;
+pub mod raster;
+pub mod depth;
+pub mod color;
+pub mod draw_target;
 
 pub use bins::Bins;
 pub use clip::ClipVertex;

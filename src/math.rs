@@ -3,7 +3,7 @@
 //! Design note: everything before snapping runs in IEEE `f32`, in a fixed
 //! order of operations, with no fused multiply-add (Rust never contracts
 //! `a * b + c` on its own), so the host and a Cortex-M build compute the same
-//! bits. Transcendental functions (`sin`, `cos`, `tan`, `sqrt`, `floor`) go
+//! bits. Transcendental functions (`sin`, `cos`, `tan`, `sqrt`) go
 //! through the [`FloatFns`] backends at the top of this file, chosen by cargo
 //! feature: `libm` (default, correctly rounded or close to it) or `micromath`
 //! (fast approximations). Nothing here decides coverage: the only float that
@@ -15,8 +15,8 @@ compile_error!("microraster needs a float backend: enable feature `libm` (defaul
 
 /// The float functions the vertex stage needs, from one backend.
 ///
-/// [`Libm`] and [`Micromath`] implement it, each behind its cargo feature;
-/// [`DefaultFloat`] is the one the plain constructors ([`Mat4::perspective`]
+/// `Libm` and `Micromath` implement it, each behind its cargo feature;
+/// `DefaultFloat` is the one the plain constructors ([`Mat4::perspective`]
 /// and friends) use: `libm` when that feature is on, else `micromath`. Both
 /// may be enabled at once, and the `*_with` constructors pick one
 /// explicitly (the host's speed-vs-error report compares them in one run).

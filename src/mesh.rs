@@ -149,7 +149,8 @@ impl Mesh<'_> {
 /// Outcode bit for a vertex with a NaN or infinite coordinate.
 pub(crate) const NONFINITE: u16 = 1 << 15;
 
-/// A vertex after the vertex stage (see [`Frame::draw_mesh_cached`]):
+/// A vertex after the vertex stage (see
+/// [`Submit::submit_mesh_cached`](crate::Submit::submit_mesh_cached)):
 /// clip-space position, outcode and, where no clipping can touch it, its
 /// snapped window position.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -246,6 +246,30 @@ pub trait Submit<const S: u32 = 8> {
     }
 }
 
+/// Implements [`Submit`] for a receiver with the fields `stage: Stage`,
+/// `stats: Stats` and a sink field: `impl_submit!([generics] Type, Sink,
+/// sink_field)`.
+macro_rules! impl_submit {
+    ([$($g:tt)*] $ty:ty, $sink:ty, $field:ident) => {
+        impl<$($g)*> $crate::pipeline::Submit<S> for $ty {
+            type Sink = $sink;
+
+            fn parts(&mut self) -> $crate::pipeline::__private::Parts<'_, $sink> {
+                $crate::pipeline::__private::Parts {
+                    stage: &self.stage,
+                    stats: &mut self.stats,
+                    sink: &mut self.$field,
+                }
+            }
+
+            fn stage(&self) -> &$crate::pipeline::Stage {
+                &self.stage
+            }
+        }
+    };
+}
+pub(crate) use impl_submit;
+
 /// Triangle counts per submission fit `u32` (ids are 32-bit).
 fn check_mesh_len(n: usize) -> Result<u64, Error> {
     if n as u64 > u32::MAX as u64 {

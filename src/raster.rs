@@ -16,14 +16,14 @@
 //! loop then visits only covered pixels; it never divides and never tests
 //! coverage.
 //!
-//! Small triangles (box at most [`SMALL_WIDTH`] pixels wide) skip the
+//! Small triangles (box at most `SMALL_WIDTH` pixels wide) skip the
 //! divisions and test the sign of the three edge values at every pixel of
 //! their box instead; both paths cover exactly the same pixels.
 //!
 //! Depth is the plane through the three `Z32` vertex depths, evaluated from
 //! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
 //! at the start of each run of pixels (a row's first covered pixel for
-//! small triangles, every [`RESYNC`] pixels of a span) and stepped by its
+//! small triangles, every `RESYNC` pixels of a span) and stepped by its
 //! gradient in between; spans step it in `Z32.16` integers. The float
 //! is `f64` for `u32` buffers: each term is at most `2^32` at a covered
 //! pixel, so the error is far below one `Z32` LSB and the written value is
@@ -45,21 +45,97 @@ use crate::depth::{z32_at, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use embedded_graphics_core::pixelcolor::Rgb888;
 
+/// The integer type edge functions are evaluated in: `i64` always works
+/// (`|E| < 2^59`); `i32` is exact for triangles whose vertices span at most
+/// [`EDGE32_SPAN`] subpixel units in x and in y (see `fits_i32`), which
+/// is most triangles of a small frame, and costs a single register (and a
+/// hardware division) on a 32-bit core.
+trait EdgeInt:
+    Copy
+    + Ord
+    + core::ops::Add<Output = Self>
+    + core::ops::Sub<Output = Self>
+    + core::ops::Mul<Output = Self>
+    + core::ops::Div<Output = Self>
+    + core::ops::Neg<Output = Self>
+    + core::ops::AddAssign
+    + core::ops::BitOr<Output = Self>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    /// `v`, which the caller has proved to fit.
+    fn narrow(v: i64) -> Self;
+    fn widen(self) -> i64;
+    fn from_usize(v: usize) -> Self;
+}
+
+macro_rules! impl_edge_int {
+    ($t:ty) => {
+        impl EdgeInt for $t {
+            const ZERO: $t = 0;
+            const ONE: $t = 1;
+            #[inline(always)]
+            fn narrow(v: i64) -> $t {
+                v as $t
+            }
+            #[inline(always)]
+            fn widen(self) -> i64 {
+                self as i64
+            }
+            #[inline(always)]
+            fn from_usize(v: usize) -> $t {
+                v as $t
+            }
+        }
+    };
+}
+
+impl_edge_int!(i32);
+impl_edge_int!(i64);
+
+/// The largest vertex span (max - min, in `Sub<S>` units, in x and in y)
+/// for which every edge value [`draw`] computes fits `i32`: 45,000 units,
+/// 175 pixels at 8 subpixel bits, 2,812 at 4.
+///
+/// Proof: `E_k(p) = (b - a) x (p - a)` is twice the signed area of the
+/// triangle `a, b, p`. The vertices lie in their bounding box, of spans at
+/// most `B`; the edge functions are evaluated at pixel centres of the
+/// triangle's pixel box (inside that bounding box) and, after a row's or a
+/// span's last pixel, at most one pixel (`2^S <= 256` units) beyond it in x
+/// and in y. So `a`, `b` and `p` lie in a square of side `B + 256`, and a
+/// triangle in a square of side `L` has at most half its area: `|E| <= L^2
+/// = 45,256^2 = 2,048,105,536`. The bias adds at most 1; the steps
+/// `|dy| << S, |dx| << S` are at most `B * 256 = 11,520,000`; the span
+/// division `clip_span` forms `-E + step - 1` at in-box points, below
+/// `2,059,625,537 < 2^31 - 1`. So no `i32` operation overflows (the property
+/// tests, which run with overflow checks on, compare triangles on both
+/// sides of the limit against the `i128` reference).
+pub const EDGE32_SPAN: i64 = 45_000;
+
+/// Whether the triangle's edge values fit `i32` ([`EDGE32_SPAN`]).
+#[inline]
+fn fits_i32(t: &SetupTriangle) -> bool {
+    let span = |v: [i32; 3]| v[0].max(v[1]).max(v[2]) as i64 - v[0].min(v[1]).min(v[2]) as i64;
+    span(t.x) <= EDGE32_SPAN && span(t.y) <= EDGE32_SPAN
+}
+
 /// One edge function, set up for stepping in whole pixels.
 #[derive(Clone, Copy)]
-struct Edge {
+struct Edge<T> {
     /// `E + bias` at the centre of the first column of the current row.
-    row: i64,
+    row: T,
     /// Change per column (`-(yb - ya) << S`).
-    step_x: i64,
+    step_x: T,
     /// Change per row (`(xb - xa) << S`).
-    step_y: i64,
+    step_y: T,
     /// 0 for a top or left edge, -1 otherwise.
     bias: i64,
 }
 
-impl Edge {
-    fn new<const S: u32>(xa: i32, ya: i32, xb: i32, yb: i32, px: i64, py: i64) -> Edge {
+impl<T: EdgeInt> Edge<T> {
+    /// Computed exactly in `i64`, then narrowed (exact: see
+    /// [`EDGE32_SPAN`] for `i32`).
+    fn new<const S: u32>(xa: i32, ya: i32, xb: i32, yb: i32, px: i64, py: i64) -> Edge<T> {
         let dx = xb as i64 - xa as i64;
         let dy = yb as i64 - ya as i64;
         // Window y points down; with positive area the interior is on the
@@ -69,37 +145,43 @@ impl Edge {
         let bias = if top_left { 0 } else { -1 };
         let e = dx * (py - ya as i64) - dy * (px - xa as i64);
         Edge {
-            row: e + bias,
-            step_x: -dy << S,
-            step_y: dx << S,
+            row: T::narrow(e + bias),
+            step_x: T::narrow(-dy << S),
+            step_y: T::narrow(dx << S),
             bias,
         }
+    }
+
+    /// The biased value `n` columns to the right of the row's start.
+    #[inline(always)]
+    fn at(&self, n: T) -> T {
+        self.row + self.step_x * n
     }
 
     /// Restricts the column range `[lo, hi]` (offsets from the first column)
     /// to where this edge covers. Returns `false` if nothing remains.
     #[inline]
-    fn clip_span(&self, lo: &mut i64, hi: &mut i64) -> bool {
+    fn clip_span(&self, lo: &mut T, hi: &mut T) -> bool {
         let e = self.row;
         let a = self.step_x;
-        if a > 0 {
+        if a > T::ZERO {
             // e + a n >= 0  <=>  n >= ceil(-e / a)
-            if e < 0 {
-                let n = (-e + a - 1) / a;
+            if e < T::ZERO {
+                let n = (-e + a - T::ONE) / a;
                 if n > *lo {
                     *lo = n;
                 }
             }
-        } else if a < 0 {
+        } else if a < T::ZERO {
             // e + a n >= 0  <=>  n <= floor(e / -a)
-            if e < 0 {
+            if e < T::ZERO {
                 return false;
             }
             let n = e / -a;
             if n < *hi {
                 *hi = n;
             }
-        } else if e < 0 {
+        } else if e < T::ZERO {
             return false;
         }
         *lo <= *hi
@@ -199,22 +281,26 @@ struct Acc<R> {
 }
 
 impl<R: Real> Shader<R> {
-    fn new<C: PixelFormat, D: DepthBuffer + ?Sized>(t: &SetupTriangle, edges: &[Edge; 3]) -> Self {
+    fn new<C: PixelFormat, D: DepthBuffer + ?Sized, T: EdgeInt>(
+        t: &SetupTriangle,
+        edges: &[Edge<T>; 3],
+    ) -> Self {
         let (mut k1, mut k2, mut dz) = (R::ZERO, R::ZERO, R::ZERO);
         if D::ENABLED {
             let inv_area = R::from_i64(t.area).recip();
             let z0 = t.z[0] as i64;
             k1 = R::from_i64(t.z[1] as i64 - z0) * inv_area;
             k2 = R::from_i64(t.z[2] as i64 - z0) * inv_area;
-            dz = k1 * R::from_i64(edges[1].step_x) + k2 * R::from_i64(edges[2].step_x);
+            dz = k1 * R::from_i64(edges[1].step_x.widen())
+                + k2 * R::from_i64(edges[2].step_x.widen());
         }
         let smooth = C::SHADED && t.smooth;
         let mut dc = [0.0f32; 4];
         if smooth {
             let st = [
-                edges[0].step_x as f32,
-                edges[1].step_x as f32,
-                edges[2].step_x as f32,
+                edges[0].step_x.widen() as f32,
+                edges[1].step_x.widen() as f32,
+                edges[2].step_x.widen() as f32,
             ];
             let cw = &t.color_w;
             for (c, d) in dc.iter_mut().enumerate().take(3) {
@@ -237,11 +323,11 @@ impl<R: Real> Shader<R> {
     /// The interpolants at the pixel whose biased edge values are `e`,
     /// evaluated from the exact edge values.
     #[inline(always)]
-    fn start<D: DepthBuffer + ?Sized>(&self, t: &SetupTriangle, e: [i64; 3]) -> Acc<R> {
+    fn start<D: DepthBuffer + ?Sized, T: EdgeInt>(&self, t: &SetupTriangle, e: [T; 3]) -> Acc<R> {
         let e = [
-            e[0] - self.bias[0],
-            e[1] - self.bias[1],
-            e[2] - self.bias[2],
+            e[0].widen() - self.bias[0],
+            e[1].widen() - self.bias[1],
+            e[2].widen() - self.bias[2],
         ];
         let z = if D::ENABLED {
             self.z0 + self.k1 * R::from_i64(e[1]) + self.k2 * R::from_i64(e[2])
@@ -314,15 +400,16 @@ pub(crate) fn draw<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized>(
     t: &SetupTriangle,
     strip: &mut Strip<'_, C, D>,
 ) -> u32 {
-    if D::WIDE {
-        draw_in::<S, C, D, f64>(t, strip)
-    } else {
-        draw_in::<S, C, D, f32>(t, strip)
+    match (D::WIDE, fits_i32(t)) {
+        (true, true) => draw_in::<S, C, D, f64, i32>(t, strip),
+        (true, false) => draw_in::<S, C, D, f64, i64>(t, strip),
+        (false, true) => draw_in::<S, C, D, f32, i32>(t, strip),
+        (false, false) => draw_in::<S, C, D, f32, i64>(t, strip),
     }
 }
 
-/// [`draw`] with depth interpolated in `R`.
-fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
+/// [`draw`] with depth interpolated in `R` and edge values in `T`.
+fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
     t: &SetupTriangle,
     strip: &mut Strip<'_, C, D>,
 ) -> u32 {
@@ -336,13 +423,13 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
     let py = ((row_first as i64) << S) + half;
     let (x, y) = (t.x, t.y);
     // Edge k is opposite vertex k: from vertex k+1 to vertex k+2.
-    let mut edges = [
+    let mut edges: [Edge<T>; 3] = [
         Edge::new::<S>(x[1], y[1], x[2], y[2], px, py),
         Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
         Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
     ];
-    let shader = Shader::<R>::new::<C, D>(t, &edges);
-    let max_n = (t.max_x - t.min_x) as i64;
+    let shader = Shader::<R>::new::<C, D, T>(t, &edges);
+    let max_n = (t.max_x - t.min_x) as usize;
     let mut written = 0u32;
     let mut base = (row_first - strip.y0) as usize * strip.width + t.min_x as usize;
 
@@ -355,18 +442,18 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
             // there, where every edge value is non-negative (no
             // cancellation).
             let mut n = 0usize;
-            while n <= max_n as usize && (e[0] | e[1] | e[2]) < 0 {
+            while n <= max_n && (e[0] | e[1] | e[2]) < T::ZERO {
                 e[0] += step[0];
                 e[1] += step[1];
                 e[2] += step[2];
                 n += 1;
             }
-            if n <= max_n as usize {
+            if n <= max_n {
                 // Covered pixels of a row are contiguous (the triangle is
                 // convex): draw until the first uncovered one.
-                let mut acc = shader.start::<D>(t, e);
-                for k in n..=max_n as usize {
-                    if (e[0] | e[1] | e[2]) < 0 {
+                let mut acc = shader.start::<D, T>(t, e);
+                for k in n..=max_n {
+                    if (e[0] | e[1] | e[2]) < T::ZERO {
                         break;
                     }
                     written += shader.pixel(t, strip, base + k, &acc, acc.z.to_u32());
@@ -385,8 +472,8 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
     }
 
     for _ in row_first..=row_last {
-        let mut lo = 0i64;
-        let mut hi = max_n;
+        let mut lo = T::ZERO;
+        let mut hi = T::from_usize(max_n);
         let covered = edges[0].clip_span(&mut lo, &mut hi)
             && edges[1].clip_span(&mut lo, &mut hi)
             && edges[2].clip_span(&mut lo, &mut hi);
@@ -394,17 +481,14 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
             // Flat span: one colour, depth stepped in Z32.16 from the span's
             // exact start (error below 1/8 LSB over 2^14 pixels), in the
             // depth buffer's branch-free loop.
-            let e = [
-                edges[0].row + edges[0].step_x * lo,
-                edges[1].row + edges[1].step_x * lo,
-                edges[2].row + edges[2].step_x * lo,
-            ];
-            let z0 = shader.start::<D>(t, e).z;
+            let e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
+            let z0 = shader.start::<D, T>(t, e).z;
             let px = C::from_fragment(t.flat, t.id);
+            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
             written += strip.depth.flat_span(
                 strip.color,
-                base + lo as usize,
-                (hi - lo + 1) as usize,
+                base + lo,
+                hi - lo + 1,
                 z0.to_fixed16(),
                 shader.dz_fixed,
                 strip.depth_func,
@@ -412,22 +496,19 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real>(
                 px,
             );
         } else if covered {
-            let mut e = [
-                edges[0].row + edges[0].step_x * lo,
-                edges[1].row + edges[1].step_x * lo,
-                edges[2].row + edges[2].step_x * lo,
-            ];
-            let mut acc = shader.start::<D>(t, e);
+            let mut e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
+            let mut acc = shader.start::<D, T>(t, e);
             // Depth exactly as on a flat span (the same Z32.16 steps from
             // the same start), so the written depth never depends on the
             // pixel type; colour re-synchronises every RESYNC pixels.
             let z0 = acc.z.to_fixed16();
+            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
             for n in lo..=hi {
-                if (n - lo) % RESYNC == 0 && n != lo {
-                    acc = shader.start::<D>(t, e);
+                if (n - lo) % RESYNC as usize == 0 && n != lo {
+                    acc = shader.start::<D, T>(t, e);
                 }
-                let z32 = z32_at(z0, shader.dz_fixed, (n - lo) as usize);
-                written += shader.pixel(t, strip, base + n as usize, &acc, z32);
+                let z32 = z32_at(z0, shader.dz_fixed, n - lo);
+                written += shader.pixel(t, strip, base + n, &acc, z32);
                 e[0] += edges[0].step_x;
                 e[1] += edges[1].step_x;
                 e[2] += edges[2].step_x;

@@ -4,7 +4,7 @@
 //! keeps the result, which costs about a hundred bytes a triangle. Where RAM
 //! is scarcer than cycles (a microcontroller drawing through a 16-row
 //! buffer) [`StripRenderer`] instead runs each submitted triangle through
-//! the same pipeline ([`Submit`]: transform, cull, clip, setup) and draws it
+//! the same pipeline ([`Submit`](crate::Submit): transform, cull, clip, setup) and draws it
 //! straight into the one strip it holds. The caller submits the scene once
 //! per strip. The pixels are bit-identical to
 //! [`Frame::render_rows`](crate::Frame::render_rows) for the same rows: it
@@ -17,10 +17,7 @@ use crate::color::PixelFormat;
 use crate::config::{check_rows, check_size, Config, Error};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
-use crate::pipeline::{
-    __private::{Parts, Sink},
-    Stage, Submit,
-};
+use crate::pipeline::{__private::Sink, impl_submit, Stage};
 use crate::raster::{draw, Strip};
 use crate::setup::SetupTriangle;
 use crate::stats::{RenderStats, Stats};
@@ -54,7 +51,7 @@ impl<C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Sink for StripSink<'
 }
 
 /// Draws triangles straight into rows `y0..y1` of a frame, at `S` subpixel
-/// bits, without storing them. Submit with [`Submit`]'s methods; they
+/// bits, without storing them. Submit with [`Submit`](crate::Submit)'s methods; they
 /// never return [`Error::StorageFull`].
 ///
 /// ```
@@ -159,23 +156,12 @@ impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b
     }
 }
 
-impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Submit<S>
-    for StripRenderer<'b, C, D, S>
-{
-    type Sink = StripSink<'b, C, D, S>;
-
-    fn parts(&mut self) -> Parts<'_, Self::Sink> {
-        Parts {
-            stage: &self.stage,
-            stats: &mut self.stats,
-            sink: &mut self.sink,
-        }
-    }
-
-    fn stage(&self) -> &Stage {
-        &self.stage
-    }
-}
+impl_submit!(
+    ['b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32]
+    StripRenderer<'b, C, D, S>,
+    StripSink<'b, C, D, S>,
+    sink
+);
 
 #[cfg(test)]
 mod tests {
@@ -184,6 +170,7 @@ mod tests {
     use crate::frame::Frame;
     use crate::math::{Mat4, Vec3};
     use crate::mesh::{Mesh, MeshColors, ProcessedVertex};
+    use crate::pipeline::Submit;
     use embedded_graphics_core::pixelcolor::Rgb888;
 
     #[test]

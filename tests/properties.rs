@@ -1045,3 +1045,63 @@ proptest! {
         prop_assert_eq!(&with, &without, "culled_object {}", stats.culled_object);
     }
 }
+
+// ---------------------------------------------------------------------------
+// The 32-bit edge fast path at its limit
+// ---------------------------------------------------------------------------
+
+/// Triangles whose vertex span (in x and y) is at or just around
+/// `raster::EDGE32_SPAN` subpixel units, one vertex in or near a 64x64
+/// frame: both sides of the switch between `i32` and `i64` edge values,
+/// where the `i32` values come closest to overflowing.
+fn edge32_limit_tri() -> impl Strategy<Value = [SubPt; 3]> {
+    let limit = microraster::raster::EDGE32_SPAN;
+    let span = prop_oneof![
+        Just(limit),
+        Just(limit + 1),
+        limit - 300..=limit,
+        limit + 1..=limit + 300
+    ];
+    (
+        (-4096i64..(64 << 8) + 4096, -4096i64..(64 << 8) + 4096),
+        span.clone(),
+        span,
+        any::<bool>(),
+        any::<bool>(),
+        0.0f64..=1.0,
+        0.0f64..=1.0,
+    )
+        .prop_map(|(a, bx, by, fx, fy, t1, t2)| {
+            let sx = if fx { 1 } else { -1 };
+            let sy = if fy { 1 } else { -1 };
+            let b = (a.0 + sx * bx, a.1 + (t1 * by as f64) as i64 * sy);
+            let c = (a.0 + (t2 * bx as f64) as i64 * sx, a.1 + sy * by);
+            [a, b, c]
+        })
+}
+
+proptest! {
+    #![proptest_config(cases(1024))]
+
+    /// At 8 and 4 subpixel bits (at 4, the same units are 16 times as many
+    /// pixels, mostly off-screen): coverage equals the `i128` reference on
+    /// both sides of the `i32` limit (overflow checks are on in tests).
+    #[test]
+    fn coverage_matches_reference_at_the_i32_edge_limit(v in edge32_limit_tri()) {
+        let (w, h) = (64, 64);
+        for s in [8u32, 4] {
+            // The same spans in subpixel units; at 4 bits the first vertex
+            // is moved to the same place in pixels.
+            let shift = |p: SubPt| if s == 8 { p } else { (p.0 - v[0].0 + v[0].0 / 16, p.1 - v[0].1 + v[0].1 / 16) };
+            let vs = v.map(shift);
+            let pos = grid_to_clip(vs, s, w, h);
+            if s == 8 {
+                prop_assume!(snap_tri::<8>(&pos, w, h) == Some(vs));
+                check_coverage::<8>(config_nocull(w, h), pos)?;
+            } else {
+                prop_assume!(snap_tri::<4>(&pos, w, h) == Some(vs));
+                check_coverage::<4>(config_nocull(w, h), pos)?;
+            }
+        }
+    }
+}

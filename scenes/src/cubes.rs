@@ -2,9 +2,10 @@
 //! rasterization tutorial.
 //!
 //! Design: the scene is one unit cube mesh (corners at ±1) drawn four times
-//! with different model transforms, seen by a fixed camera. It is kept as
-//! plain arrays (no core types) so the host can feed it to whatever API the
-//! core offers and tests can check the geometry independently.
+//! with different model transforms, seen by a fixed camera. The geometry is
+//! plain arrays (so tests can check it independently of the core), and
+//! [`MESH`] wraps them as the core's `Mesh` for the host, the firmware and
+//! the simulator alike.
 //!
 //! Triangles come in coplanar pairs, one pair per cube face; [`TRIANGLE_FACE`]
 //! maps a triangle to its face and [`FACE_COLORS`] gives each face a colour

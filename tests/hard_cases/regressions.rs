@@ -182,7 +182,7 @@ fn bounding_sphere_keeps_a_tiny_mesh_far_from_the_origin() {
     assert_eq!(with, without);
 }
 
-/// Issue 13, item 7: `render_strip` accepted the bins of a 64-row frame on
+/// `render_strip` accepted the bins of a 64-row frame on
 /// a 20-row one, and bins made before more triangles were added.
 #[test]
 fn bins_of_another_frame_are_refused() {
@@ -230,7 +230,7 @@ fn bins_of_another_frame_are_refused() {
     }
 }
 
-/// Issue 8: a finite input is never counted as non-finite. The triangle
+/// A finite input is never counted as non-finite. The triangle
 /// below lies at y = -1e38 (drawn as nothing), and all-zero vertices are no
 /// points at all (degenerate).
 #[test]
@@ -286,7 +286,7 @@ fn finite_inputs_are_never_counted_as_nonfinite() {
 }
 
 /// Depth buffers can be arrays as well as slices, and frames need no type
-/// annotation (issue 8).
+/// annotation.
 #[test]
 fn arrays_are_depth_buffers() {
     let tri = [
