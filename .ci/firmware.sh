@@ -49,6 +49,36 @@ boards=(
 )
 variants=("" "flat" "no-depth" "no-depth,flat")
 budget=24576
+table_header="| board | features | flash B | statics B | stack B | RAM B | pixels written | instructions/frame | display push | render | clears | geometry (all strips) | rasterization | render instr/px |"
+# Columns 8-13 of the table (frame, display push, render, clears,
+# geometry, rasterization) are the instruction counts of record.
+record=$root/docs/embedded.md
+tolerance_pct=${FIRMWARE_COUNT_TOLERANCE_PCT:-1}
+
+# check_counts BOARD FEATURES "frame push render clears geometry raster":
+# fails if any count grew by more than tolerance_pct over the row
+# recorded in docs/embedded.md (a missing row fails too).
+check_counts() {
+  local board=$1 name=$2 now=$3 recorded
+  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+    '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $9, $10, $11, $12, $13, $14; exit }' "$record")
+  if [ -z "$recorded" ]; then
+    echo "FAIL: no row for $board $name in docs/embedded.md"
+    return 1
+  fi
+  local labels=(frame display-push render clears geometry rasterization) i=0 bad=0
+  read -r -a was <<<"$recorded"
+  read -r -a is <<<"$now"
+  for i in 0 1 2 3 4 5; do
+    if [ $(( is[i] * 100 )) -gt $(( was[i] * (100 + tolerance_pct) )) ]; then
+      echo "FAIL: $board $name ${labels[i]} ${is[i]} instructions, over 1.0${tolerance_pct}x the recorded ${was[i]}"
+      bad=1
+    elif [ $(( is[i] * 100 )) -lt $(( was[i] * (100 - tolerance_pct) )) ]; then
+      echo "note: $board $name ${labels[i]} ${is[i]}, below the recorded ${was[i]}: update docs/embedded.md"
+    fi
+  done
+  return "$bad"
+}
 log=$root/target/firmware
 mkdir -p "$log"
 rows=()
@@ -87,8 +117,10 @@ for b in "${boards[@]}"; do
     frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
     pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
     perpx=$(sed -n 's/.*per written pixel \([0-9.]*\)$/\1/p' "$out")
-    display=$(sed -n 's/^ *display stand-in (hash) *\([0-9]*\) .*/\1/p' "$out")
+    display=$(sed -n 's/^ *display push (checksum) *\([0-9]*\) .*/\1/p' "$out")
+    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
     render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
+    clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
     geometry=$(sed -n 's/^ *geometry x [0-9]* strips *\([0-9]*\) .*/\1/p' "$out")
     raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
     statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
@@ -98,14 +130,18 @@ for b in "${boards[@]}"; do
       echo "FAIL: $board uses $ram B of RAM, over the $budget B budget"
       failed=1
     fi
-    rows+=("| $board | $name | $((text + data)) | $statics | $stack | $ram | $frame | $pixels | $perpx | $display | $render_px | $geometry | $raster |")
+    row="| $board | $name | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |"
+    rows+=("$row")
+    # The counts of record: docs/embedded.md's row for this board and
+    # variant. QEMU's counts are deterministic, so any growth is real.
+    check_counts "$board" "$name" "$frame $display $render $clears $geometry $raster" || failed=1
   done
 done
 cd "$root"
 
-step "budget table (320x240 Rgb565, four cubes)"
-echo "| board | features | flash B (text+data) | statics B | stack B | RAM B | instructions/frame | pixels written | instr/pixel | of which display stand-in | render instr/pixel | geometry (all strips) | rasterization |"
-echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+step "budget table (320x240 Rgb565, four cubes; paste into docs/embedded.md when the counts change)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${rows[@]}"
 
 if [ "$failed" -ne 0 ]; then

@@ -105,19 +105,22 @@ fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
         return 0;
     };
     let mut written = 0;
+    let mut z = z0;
     for (n, cp) in c.iter_mut().enumerate() {
-        if buf.test_and_set(start + n, z32_at(z0, dz, n), func, write) {
+        if buf.test_and_set(start + n, z32_of(z), func, write) {
             *cp = px;
             written += 1;
         }
+        z = z.wrapping_add(dz);
     }
     written
 }
 
-/// `Z32` at step `n` of a span in `Z32.16` (wrapping, then clamped).
+/// `Z32` of a `Z32.16` value (clamped). Spans step `z` by `dz` with
+/// wrapping additions: the same integers as `z0 + n * dz`, without the
+/// 64-bit multiply.
 #[inline(always)]
-pub(crate) fn z32_at(z0: i64, dz: i64, n: usize) -> u32 {
-    let z = z0.wrapping_add(dz.wrapping_mul(n as i64));
+pub(crate) fn z32_of(z: i64) -> u32 {
     (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32
 }
 
@@ -139,6 +142,12 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn from_z32(z: u32) -> Self;
     /// The word as `Z32` (a `u16` gives its value times `2^16`).
     fn to_z32(self) -> u32;
+    /// The word for a `Z32.16` depth, clamped to `[0, 1]`: the same as
+    /// `from_z32` of the clamped `Z32`, in fewer operations.
+    #[inline(always)]
+    fn from_z32_16(z: i64) -> Self {
+        Self::from_z32(z32_of(z))
+    }
 }
 
 impl DepthWord for u16 {
@@ -152,6 +161,12 @@ impl DepthWord for u16 {
     #[inline(always)]
     fn to_z32(self) -> u32 {
         (self as u32) << 16
+    }
+    /// `clamp(z, 0, 2^48 - 1) >> 32` is `clamp(z >> 32, 0, 2^16 - 1)`
+    /// (flooring is monotone): one 32-bit saturation of the high word.
+    #[inline(always)]
+    fn from_z32_16(z: i64) -> Self {
+        ((z >> 32).clamp(0, 0xffff)) as u16
     }
 }
 
@@ -196,12 +211,14 @@ impl<W: DepthWord> DepthBuffer for [W] {
         };
         let le = func == DepthFunc::LessEqual;
         let mut written = 0u32;
-        for (n, (cp, dp)) in c.iter_mut().zip(d.iter_mut()).enumerate() {
-            let z = W::from_z32(z32_at(z0, dz, n));
-            let pass = z < *dp || (le && z == *dp);
-            *dp = if pass { z } else { *dp };
+        let mut z = z0;
+        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+            let zw = W::from_z32_16(z);
+            let pass = zw < *dp || (le && zw == *dp);
+            *dp = if pass { zw } else { *dp };
             *cp = if pass { px } else { *cp };
             written += pass as u32;
+            z = z.wrapping_add(dz);
         }
         written
     }

@@ -41,7 +41,7 @@
 //! division per pixel.
 
 use crate::color::PixelFormat;
-use crate::depth::{z32_at, DepthBuffer, DepthFunc};
+use crate::depth::{z32_of, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use embedded_graphics_core::pixelcolor::Rgb888;
 
@@ -501,14 +501,14 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: Ed
             // Depth exactly as on a flat span (the same Z32.16 steps from
             // the same start), so the written depth never depends on the
             // pixel type; colour re-synchronises every RESYNC pixels.
-            let z0 = acc.z.to_fixed16();
+            let mut z = acc.z.to_fixed16();
             let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
             for n in lo..=hi {
                 if (n - lo) % RESYNC as usize == 0 && n != lo {
                     acc = shader.start::<D, T>(t, e);
                 }
-                let z32 = z32_at(z0, shader.dz_fixed, n - lo);
-                written += shader.pixel(t, strip, base + n, &acc, z32);
+                written += shader.pixel(t, strip, base + n, &acc, z32_of(z));
+                z = z.wrapping_add(shader.dz_fixed);
                 e[0] += edges[0].step_x;
                 e[1] += edges[1].step_x;
                 e[2] += edges[2].step_x;

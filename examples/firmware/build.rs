@@ -11,11 +11,12 @@
 //! purpose by the other path: the whole frame set up once in a [`Frame`]
 //! and rendered as one 240-row strip, where the firmware submits the scene
 //! to a `StripRenderer` for every strip of 16 (or 8) rows. The hash is the
-//! firmware's: FNV-1a 64 over each `Rgb565` pixel's two bytes, high byte
-//! first, rows top to bottom.
+//! firmware's: `microraster_scenes::checksum::FrameChecksum` over the
+//! `Rgb565` pixels, rows top to bottom.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
 use microraster::{Config, Frame, NoDepth, SetupTriangle, Submit};
+use microraster_scenes::checksum::FrameChecksum;
 use microraster_scenes::cubes;
 use std::env;
 use std::fmt::Write as _;
@@ -60,16 +61,11 @@ fn board(target: &str) -> Board {
     }
 }
 
-/// FNV-1a 64 of the frame as a display receives it.
-fn fnv1a_rgb565(pixels: &[Rgb565]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for p in pixels {
-        for b in p.into_storage().to_be_bytes() {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-    h
+/// The frame's checksum as the display receives it.
+fn frame_checksum(pixels: &[Rgb565]) -> u64 {
+    let mut c = FrameChecksum::new();
+    c.extend(pixels.iter().map(|p| p.into_storage()));
+    c.value()
 }
 
 fn host_checksum(depth: bool) -> u64 {
@@ -87,7 +83,7 @@ fn host_checksum(depth: bool) -> u64 {
         frame.render_rows(0, HEIGHT, &mut color, &mut NoDepth)
     }
     .unwrap();
-    fnv1a_rgb565(&color)
+    frame_checksum(&color)
 }
 
 fn main() {

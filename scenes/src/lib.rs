@@ -11,4 +11,5 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod checksum;
 pub mod cubes;

@@ -17,6 +17,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use microraster::prelude::Submit;
 use microraster::{Config, DepthBuffer, Frame, NoDepth, SetupTriangle, StripDrawer, StripRenderer};
+use microraster_scenes::checksum::FrameChecksum;
 use microraster_scenes::cubes;
 
 const WIDTH: u32 = 320;
@@ -31,18 +32,18 @@ fn expected(key: &str) -> u64 {
     u64::from_str_radix(line.trim().trim_start_matches("0x"), 16).unwrap()
 }
 
-/// A display that takes whole rows in order and hashes them: FNV-1a 64
-/// over each pixel's two bytes, high byte first.
+/// A display that takes whole rows in order and checksums them as the
+/// firmware's display stand-in does.
 struct Hasher {
     rows: u32,
-    hash: u64,
+    sum: FrameChecksum,
 }
 
 impl Hasher {
     fn new() -> Hasher {
         Hasher {
             rows: 0,
-            hash: 0xcbf2_9ce4_8422_2325,
+            sum: FrameChecksum::new(),
         }
     }
 }
@@ -71,9 +72,7 @@ impl DrawTarget for Hasher {
         }
         let mut n = 0;
         for c in colors.into_iter().take((WIDTH * area.size.height) as usize) {
-            for b in c.into_storage().to_be_bytes() {
-                self.hash = (self.hash ^ u64::from(b)).wrapping_mul(0x100_0000_01b3);
-            }
+            self.sum.push(c.into_storage());
             n += 1;
         }
         assert_eq!(n, WIDTH * area.size.height);
@@ -105,7 +104,7 @@ fn immediate(rows: u32, depth: bool) -> u64 {
             .unwrap();
     }
     assert_eq!(target.rows, HEIGHT);
-    target.hash
+    target.sum.value()
 }
 
 fn from_frame(rows: u32, depth: bool) -> u64 {
@@ -127,7 +126,7 @@ fn from_frame(rows: u32, depth: bool) -> u64 {
             .draw_frame(&mut target, &frame)
             .unwrap();
     }
-    target.hash
+    target.sum.value()
 }
 
 fn check(key: &str, depth: bool) {

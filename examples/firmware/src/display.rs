@@ -1,13 +1,14 @@
-//! The display stand-in: a [`DrawTarget`] that hashes what it receives.
+//! The display stand-in: a [`DrawTarget`] that checksums what it receives.
 //!
 //! It behaves like a driver for an SPI display that is only ever written
 //! whole rows at a time: each `fill_contiguous` must cover full rows and
 //! continue where the last one stopped (anything else is an error, which
-//! the strip adapter hands back), and its pixels go, two bytes each, high
-//! byte first, into an FNV-1a 64 hash instead of onto the wire. The hash
-//! of a frame therefore does not depend on how it was cut into strips.
-//! The instructions it spends are counted apart, as a real display's DMA
-//! transfer would not be.
+//! the strip adapter hands back), and its pixels go, two to a 32-bit word
+//! as a DMA transfer packs them, into a checksum
+//! (`microraster_scenes::checksum`: two additions a word) instead of onto
+//! the wire. The checksum of a frame does not depend on how it was cut
+//! into strips (rows are an even number of pixels wide). The instructions
+//! it spends are counted apart, on their own line.
 
 use crate::clock::Clock;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -15,11 +16,7 @@ use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
-
-/// FNV-1a 64 offset basis.
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-/// FNV-1a 64 prime.
-const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+use microraster_scenes::checksum::FrameChecksum;
 
 /// Why the stand-in refused a write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,16 +27,16 @@ pub enum DisplayError {
     OutOfOrder,
 }
 
-/// A `width x height` Rgb565 display that hashes the frame it is sent.
+/// A `width x height` Rgb565 display that checksums the frame it is sent.
 pub struct HashDisplay {
     size: Size,
     next_row: u32,
-    hash: u64,
+    sum: FrameChecksum,
     /// Rectangles received.
     pub pushes: u32,
     /// The clock, shared with the caller, and the ticks spent in here.
     pub clock: Clock,
-    /// SysTick ticks spent hashing.
+    /// SysTick ticks spent in the checksum.
     pub ticks: u64,
 }
 
@@ -48,7 +45,7 @@ impl HashDisplay {
         HashDisplay {
             size: Size::new(width, height),
             next_row: 0,
-            hash: FNV_OFFSET,
+            sum: FrameChecksum::new(),
             pushes: 0,
             clock,
             ticks: 0,
@@ -57,7 +54,7 @@ impl HashDisplay {
 
     /// The hash of the frame, once every row has arrived.
     pub fn checksum(&self) -> Option<u64> {
-        (self.next_row == self.size.height).then_some(self.hash)
+        (self.next_row == self.size.height).then(|| self.sum.value())
     }
 }
 
@@ -91,18 +88,24 @@ impl DrawTarget for HashDisplay {
             return Err(DisplayError::OutOfOrder);
         }
         let n = (area.size.width * area.size.height) as usize;
-        let mut h = self.hash;
-        let mut received = 0;
-        for c in colors.into_iter().take(n) {
-            let raw: u16 = c.into_storage();
-            h = (h ^ u64::from(raw >> 8)).wrapping_mul(FNV_PRIME);
-            h = (h ^ u64::from(raw & 0xff)).wrapping_mul(FNV_PRIME);
-            received += 1;
+        let mut sum = self.sum;
+        let mut it = colors.into_iter();
+        // Two pixels a word, as a 32-bit DMA transfer moves them (rows of
+        // an even width: no half word is left over).
+        for _ in 0..n / 2 {
+            let (Some(c0), Some(c1)) = (it.next(), it.next()) else {
+                return Err(DisplayError::OutOfOrder);
+            };
+            let (lo, hi): (u16, u16) = (c0.into_storage(), c1.into_storage());
+            sum.push_word(lo as u32 | (hi as u32) << 16);
         }
-        if received != n {
-            return Err(DisplayError::OutOfOrder);
+        if n % 2 == 1 {
+            let Some(c) = it.next() else {
+                return Err(DisplayError::OutOfOrder);
+            };
+            sum.push(c.into_storage());
         }
-        self.hash = h;
+        self.sum = sum;
         self.next_row += area.size.height;
         self.pushes += 1;
         self.ticks += self.clock.now() - start;

@@ -256,7 +256,7 @@ fn main() -> ! {
         b
     );
     let (a, b) = per_px(shown);
-    hprintln!("  display stand-in (hash)  {} ({}.{}/px)", shown, a, b);
+    hprintln!("  display push (checksum)  {} ({}.{}/px)", shown, a, b);
     let (a, b) = per_px(render);
     hprintln!("  render                   {} ({}.{}/px)", render, a, b);
     let (a, b) = per_px(clears);
