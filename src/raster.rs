@@ -67,10 +67,16 @@ trait EdgeInt:
     fn narrow(v: i64) -> Self;
     fn widen(self) -> i64;
     fn from_usize(v: usize) -> Self;
+    /// `self - bias` (the unbiased edge value, which fits `Self`: see
+    /// [`EDGE32_SPAN`]) as `R`, converted from `i32` where `Self` is
+    /// (one instruction on an FPU, where `i64` takes a library call).
+    fn unbiased<R: Real>(self, bias: i64) -> R;
+    /// `self - bias` as `f32`.
+    fn unbiased_f32(self, bias: i64) -> f32;
 }
 
 macro_rules! impl_edge_int {
-    ($t:ty) => {
+    ($t:ty, $from:ident) => {
         impl EdgeInt for $t {
             const ZERO: $t = 0;
             const ONE: $t = 1;
@@ -86,12 +92,20 @@ macro_rules! impl_edge_int {
             fn from_usize(v: usize) -> $t {
                 v as $t
             }
+            #[inline(always)]
+            fn unbiased<R: Real>(self, bias: i64) -> R {
+                R::$from(self - bias as $t)
+            }
+            #[inline(always)]
+            fn unbiased_f32(self, bias: i64) -> f32 {
+                (self - bias as $t) as f32
+            }
         }
     };
 }
 
-impl_edge_int!(i32);
-impl_edge_int!(i64);
+impl_edge_int!(i32, from_i32);
+impl_edge_int!(i64, from_i64);
 
 /// The largest vertex span (max - min, in `Sub<S>` units, in x and in y)
 /// for which every edge value [`draw`] computes fits `i32`: 45,000 units,
@@ -215,6 +229,7 @@ const RESYNC: i64 = 16;
 trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self> {
     const ZERO: Self;
     fn from_i64(v: i64) -> Self;
+    fn from_i32(v: i32) -> Self;
     fn from_u32(v: u32) -> Self;
     fn recip(self) -> Self;
     /// Saturating, flooring conversion (NaN gives 0).
@@ -229,6 +244,10 @@ macro_rules! impl_real {
             const ZERO: $t = 0.0;
             #[inline(always)]
             fn from_i64(v: i64) -> $t {
+                v as $t
+            }
+            #[inline(always)]
+            fn from_i32(v: i32) -> $t {
                 v as $t
             }
             #[inline(always)]
@@ -324,19 +343,20 @@ impl<R: Real> Shader<R> {
     /// evaluated from the exact edge values.
     #[inline(always)]
     fn start<D: DepthBuffer + ?Sized, T: EdgeInt>(&self, t: &SetupTriangle, e: [T; 3]) -> Acc<R> {
-        let e = [
-            e[0].widen() - self.bias[0],
-            e[1].widen() - self.bias[1],
-            e[2].widen() - self.bias[2],
-        ];
         let z = if D::ENABLED {
-            self.z0 + self.k1 * R::from_i64(e[1]) + self.k2 * R::from_i64(e[2])
+            self.z0
+                + self.k1 * e[1].unbiased::<R>(self.bias[1])
+                + self.k2 * e[2].unbiased::<R>(self.bias[2])
         } else {
             R::ZERO
         };
         let mut c = [0.0f32; 4];
         if self.smooth {
-            let f = [e[0] as f32, e[1] as f32, e[2] as f32];
+            let f = [
+                e[0].unbiased_f32(self.bias[0]),
+                e[1].unbiased_f32(self.bias[1]),
+                e[2].unbiased_f32(self.bias[2]),
+            ];
             let cw = &t.color_w;
             for (ch, v) in c.iter_mut().enumerate().take(3) {
                 *v = f[0] * cw[0][ch] + f[1] * cw[1][ch] + f[2] * cw[2][ch];
