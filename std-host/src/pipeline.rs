@@ -19,7 +19,7 @@
 //! submission order, so the image is byte-identical for any thread count and
 //! any strip height.
 
-use crate::render::{ObjectColors, Scene};
+use crate::scene::{ObjectColors, Scene};
 use microraster::{
     Bins, ClipVertex, Config, Error, Frame, MeshColors, NoDepth, Pixel, ProcessedVertex,
     SetupTriangle, Stats, Vec4,
@@ -617,7 +617,7 @@ fn ms(t: Instant) -> f64 {
 mod tests {
     use super::*;
     use crate::cliptris::ClipTri;
-    use crate::render::{clip_tris_scene, cubes_scene};
+    use crate::scene::{clip_tris_scene, cubes_scene, View};
     use microraster::pixelcolor::{Rgb888, RgbColor};
     use microraster::CullMode;
 
@@ -654,7 +654,7 @@ mod tests {
 
     #[test]
     fn partition_covers_the_scene_in_order() {
-        let mut scene = cubes_scene(32, 24);
+        let mut scene = cubes_scene(&View::new(32, 24)).unwrap();
         scene.clip_tris = (0..10).map(small).collect();
         for parts in [1, 2, 3, 7, 100] {
             let chunks = partition(&scene, parts);

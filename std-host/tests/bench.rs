@@ -78,7 +78,10 @@ fn sphere_two_frames_prints_valid_json() {
 
 #[test]
 fn thread_list_peers_and_floor() {
-    let v = bench_json(&[
+    // The peers only with the `peers` feature (tests/cli.rs checks the
+    // error without it).
+    let peers = cfg!(feature = "peers");
+    let mut args = vec![
         "--scene",
         "cubes",
         "--size",
@@ -89,24 +92,31 @@ fn thread_list_peers_and_floor() {
         "0",
         "--threads",
         "1,2",
-        "--peers",
         "--floor",
         "--no-split",
         "--compact",
-    ]);
+    ];
+    if peers {
+        args.push("--peers");
+    }
+    let v = bench_json(&args);
     assert!(v.get("split").is_none());
     let s = &v["scaling"];
     assert_eq!(s["identical_output"], true);
     assert_eq!(s["1"]["speedup"], 1.0);
     positive(&s["2"], "speedup");
     assert_eq!(s["1"]["checksum"], v["checksum"]);
-    let p = &v["peers"];
-    positive(p, "euc_over_microraster");
-    positive(&p["embedded_graphics_2d"], "eg_over_microraster");
-    assert_eq!(
-        p["euc"]["covered_pixels"], p["microraster"]["covered_pixels"],
-        "euc and microraster cover the same pixels of the cubes"
-    );
+    if peers {
+        let p = &v["peers"];
+        positive(p, "euc_over_microraster");
+        positive(&p["embedded_graphics_2d"], "eg_over_microraster");
+        assert_eq!(
+            p["euc"]["covered_pixels"], p["microraster"]["covered_pixels"],
+            "euc and microraster cover the same pixels of the cubes"
+        );
+    } else {
+        assert!(v.get("peers").is_none());
+    }
     let f = &v["floor"];
     positive(f, "floor_ms");
     positive(f, "frame_over_floor");
