@@ -19,8 +19,9 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
 use microraster::{Config, Frame, Mesh, ProcessedVertex, SetupTriangle};
-use microraster_host::bench_scenes::{self, View};
-use microraster_host::render::Object;
+use microraster_host::bench_scenes;
+use microraster_host::scene::Object;
+use microraster_host::scene::View;
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -8,7 +8,14 @@
 //! names a supported format. `--obj`, `--clip-tris` and an explicit `--scene`
 //! are mutually exclusive; [`RenderArgs::source`] says which one to use.
 //! Vectors are written `X,Y,Z`; negative values work both as `--eye -1,2,3`
-//! and `--eye=-1,2,3`.
+//! and `--eye=-1,2,3`, and `--fov -5` reaches the range check instead of
+//! being taken for an option.
+//!
+//! Every subcommand's options are defined here ([`RenderArgs`],
+//! [`BenchArgs`], [`ReportArgs`]), so data flows one way: this module
+//! parses, and the command modules (`render_cmd`, `bench`, `report`) take
+//! what it made; it imports none of them. Checks that need the scene (a
+//! camera for a scene without one, eye equal to target) are the command's.
 
 use std::path::PathBuf;
 

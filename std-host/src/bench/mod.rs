@@ -2,14 +2,14 @@
 //!
 //! Design: the scene is built once (built-in scenes from
 //! [`crate::bench_scenes`], or `--obj` framed like `render --obj`); then
-//! every frame goes through one [`FramePipeline`] (see [`crate::pipeline`]:
+//! every frame goes through one [`FramePipeline`](crate::pipeline::FramePipeline) (see [`crate::pipeline`]:
 //! the same setup, binning and strip drawing as [`crate::render::render`],
 //! which builds a fresh pipeline per image), kept for the whole run so its
 //! vertex caches, setup storage and bins, and the colour and depth buffers
 //! here, are reused from one frame to the next; the final RGB8 conversion is
 //! skipped. With one thread nothing is spawned. Spinning scenes get the
 //! matrix of frame `k` before the frame's clock starts. Only the frame
-//! itself is timed, with [`Instant`]; the report gives median, min, mean and
+//! itself is timed, with [`std::time::Instant`]; the report gives median, min, mean and
 //! max over `--frames` frames after `--warmup` untimed ones, and the medians
 //! of the stages (vertex, triangles, binning, raster). `--render-fn` also
 //! times `render::render` itself, as a cross-check (same checksum) and to
@@ -39,10 +39,10 @@
 //! The code is split by concern: [`runs`] (the timed loop, one pipeline per
 //! thread count), [`sections`] (split and floor), [`stats`] (medians),
 //! [`progress`] (stderr progress lines) and, with the `peers` feature,
-//! [`peers`]. Without that feature `--peers` is an error that names it; the
+//! `peers`. Without that feature `--peers` is an error that names it; the
 //! rest of `bench` works the same.
 
-mod progress;
+pub mod progress;
 pub mod runs;
 pub mod sections;
 pub mod stats;

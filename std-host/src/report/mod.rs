@@ -12,7 +12,7 @@
 //!   building the matrices with the configuration's float backend, setting
 //!   up every triangle into a [`Frame`] and rendering all rows into an
 //!   `Rgb888` buffer and a depth buffer (buffers allocated beforehand);
-//! - the error against [`reference`], which renders the same scene
+//! - the error against [`reference`](mod@reference), which renders the same scene
 //!   from `f64` vertices and `f64` matrices with no snapping:
 //!   pixels whose triangle id differs, those among them where only coverage
 //!   differs (background in one, a triangle in the other), the depth error
@@ -40,7 +40,7 @@
 //! system font is needed.
 //!
 //! The code is split by concern: [`scenes`] (the scenes and their matrices),
-//! `core_run` (the timed core frames), [`reference`] (the `f64` renderer),
+//! `core_run` (the timed core frames), [`reference`](mod@reference) (the `f64` renderer),
 //! `compare` (errors and what explains them), `markdown` and `plot` (the
 //! output). The whole module is built only with the `report` feature.
 
