@@ -154,7 +154,8 @@ fn bench_checksum_matches_render() {
         "0",
         "--no-split",
     ]);
-    let out = std::env::temp_dir().join(format!("microraster-bench-{}.png", std::process::id()));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench.png");
     let o = run(&[
         "render",
         "--scene",
@@ -166,7 +167,6 @@ fn bench_checksum_matches_render() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_file(&out);
     assert_eq!(
         v["checksum"].as_str(),
         Some(String::from_utf8_lossy(&o.stdout).trim())
@@ -175,7 +175,8 @@ fn bench_checksum_matches_render() {
 
 #[test]
 fn render_knows_the_bench_scenes() {
-    let out = std::env::temp_dir().join(format!("microraster-sphere-{}.png", std::process::id()));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sphere.png");
     let o = run(&[
         "render",
         "--scene",
@@ -189,7 +190,6 @@ fn render_knows_the_bench_scenes() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_file(&out);
     let v: Value = serde_json::from_slice(&o.stdout).expect("stats JSON");
     assert_eq!(v["counters"]["submitted"], 20_000);
 }
