@@ -9,7 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-cargo build --release -q -p microraster-host
+# The peers are a cargo feature of the host (not in the default build).
+cargo build --release -q -p microraster-host --features peers
 bin=target/release/microraster
 out=target/ci/bench
 mkdir -p "$out"
@@ -64,7 +65,7 @@ check "$out/quad.json" "$common" 'd["pixels_written"] == 1920 * 1080' \
   'pos(d["floor"]["floor_ms"])' 'pos(d["floor"]["frame_over_floor"])'
 
 if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
-  cargo bench -q -p microraster-host --bench core --no-run
+  cargo bench -q -p microraster-host --features criterion --bench core --no-run
 fi
 
 echo "bench smoke: all runs passed"

@@ -8,7 +8,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-target/ci/report}
-cargo run --release -q -p microraster-host -- report speed-vs-error "$out" --quick --no-progress
+# The report is a cargo feature of the host (not in the default build).
+cargo run --release -q -p microraster-host --features report -- report speed-vs-error "$out" --quick --no-progress
 test -s "$out/speed-vs-error.md"
 test -s "$out/speed-vs-error.png"
 sed -n '/^## By configuration/,/^★/p' "$out/speed-vs-error.md"

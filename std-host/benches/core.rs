@@ -20,8 +20,9 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
 use microraster::prelude::Submit;
 use microraster::{Config, Frame, Mesh, ProcessedVertex, SetupTriangle};
-use microraster_host::bench_scenes::{self, View};
-use microraster_host::render::Object;
+use microraster_host::bench_scenes;
+use microraster_host::scene::Object;
+use microraster_host::scene::View;
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -65,7 +66,7 @@ fn cases() -> Vec<Case> {
 
 fn storage_for(mesh: &Mesh<'_>) -> Vec<SetupTriangle> {
     let n = mesh.indices.len();
-    vec![SetupTriangle::EMPTY; n + n / 8 + 64]
+    vec![SetupTriangle::EMPTY; Frame::<8>::storage_for(n)]
 }
 
 fn stages(c: &mut Criterion) {

@@ -1,6 +1,6 @@
 //! The built-in scenes of `microraster bench` (also `render --scene NAME`).
 //!
-//! Design: every scene is a plain [`render::Scene`] plus an optional
+//! Design: every scene is a plain [`Scene`] plus an optional
 //! [`Spin`], the per-frame model rotation about the y axis that the
 //! benchmark applies before frame `k` (angle `k * step`). Meshes are built
 //! or loaded once, outside any timed region. The scenes of issue 4:
@@ -24,7 +24,7 @@
 //! repository (path fixed at compile time, see [`BUNNY_OBJ`]).
 
 use crate::obj;
-use crate::render::{self, Object, ObjectColors, Scene};
+use crate::scene::{self, Object, ObjectColors, Scene, View};
 use microraster::pixelcolor::Rgb888;
 use microraster::{BoundingSphere, Mat4, Vec3};
 use std::collections::HashMap;
@@ -48,40 +48,6 @@ pub const SPHERE_STACKS: u32 = 100;
 pub const SPHERE_SLICES: u32 = 100;
 /// Distance of the sphere's centre in front of the eye.
 pub const SPHERE_Z: f32 = -3.2;
-
-/// Camera and frame settings a scene is built for. `None` takes the
-/// scene's own default.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct View {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Eye position.
-    pub eye: Option<[f32; 3]>,
-    /// Point looked at.
-    pub target: Option<[f32; 3]>,
-    /// Vertical field of view in degrees.
-    pub fov: Option<f32>,
-}
-
-impl View {
-    /// A view of `width x height` with the scene's camera.
-    pub fn new(width: u32, height: u32) -> View {
-        View {
-            width,
-            height,
-            eye: None,
-            target: None,
-            fov: None,
-        }
-    }
-
-    /// Width / height.
-    pub fn aspect(&self) -> f32 {
-        self.width as f32 / self.height as f32
-    }
-}
 
 /// Per-frame rotation of every object about the y axis through its pivot.
 #[derive(Clone, Debug, PartialEq)]
@@ -158,6 +124,10 @@ impl BenchScene {
     }
 }
 
+/// Why `--eye`, `--target` and `--fov` are refused for the quad.
+pub const NO_CAMERA_QUAD: &str = "the quad scene is two triangles given in clip space and has \
+     no camera: --eye, --target and --fov do not apply to it";
+
 /// Default frame size of a built-in scene.
 pub fn default_size(name: &str) -> (u32, u32) {
     match name {
@@ -167,16 +137,18 @@ pub fn default_size(name: &str) -> (u32, u32) {
     }
 }
 
-/// Builds the built-in scene `name` for `view`.
+/// Builds the built-in scene `name` for `view`. The quad has no camera, so
+/// a camera setting in `view` is an error there.
 pub fn builtin(name: &str, view: &View) -> Result<BenchScene, String> {
     let (scene, spin) = match name {
-        "cubes" => (render::cubes_scene(view.width, view.height), None),
+        "cubes" => (scene::cubes_scene(view)?, None),
         "sphere" => {
-            let (scene, spin) = sphere_scene(view, SPHERE_STACKS, SPHERE_SLICES);
+            let (scene, spin) = sphere_scene(view, SPHERE_STACKS, SPHERE_SLICES)?;
             (scene, Some(spin))
         }
         "bunny" => (bunny_scene(view, 0)?, None),
         "bunny-subdiv" => (bunny_scene(view, 2)?, None),
+        "quad" if view.has_camera() => return Err(NO_CAMERA_QUAD.to_string()),
         "quad" => (quad_scene(), None),
         other => {
             return Err(format!(
@@ -244,7 +216,7 @@ pub fn normal_colors(normals: &[Vec3]) -> Vec<Rgb888> {
 
 /// tgx's sphere scene for `view` (eye at the origin looking down -z unless
 /// the view says otherwise), with its spin of 1° per frame.
-pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> (Scene, Spin) {
+pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spin), String> {
     let (positions, indices) = uv_sphere(stacks, slices, 1.0);
     // On a unit sphere the position is the normal.
     let colors = normal_colors(&positions);
@@ -252,11 +224,10 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> (Scene, Spin) {
     let proj = Mat4::perspective(fov.to_radians(), view.aspect(), 1.0, 100.0);
     let view_m = match (view.eye, view.target) {
         (None, None) => Mat4::IDENTITY,
-        (eye, target) => Mat4::look_at(
-            Vec3::from_array(eye.unwrap_or([0.0; 3])),
-            Vec3::from_array(target.unwrap_or([0.0, 0.0, SPHERE_Z])),
-            Vec3::new(0.0, 1.0, 0.0),
-        ),
+        (eye, target) => scene::look_at(
+            eye.unwrap_or([0.0; 3]),
+            target.unwrap_or([0.0, 0.0, SPHERE_Z]),
+        )?,
     };
     let bounds = BoundingSphere::from_points(&positions);
     let spin = Spin {
@@ -278,7 +249,7 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> (Scene, Spin) {
         clip_tris: Vec::new(),
     };
     spin.apply(&mut scene, 0);
-    (scene, spin)
+    Ok((scene, spin))
 }
 
 /// Area-weighted vertex normals (unit length; zero for unused vertices).
@@ -335,12 +306,16 @@ pub fn load_bunny() -> Result<obj::LoadedMesh, String> {
 /// (or seen as `view` says), Gouraud-shaded by a head light.
 pub fn bunny_scene(view: &View, subdivisions: u32) -> Result<Scene, String> {
     let mesh = load_bunny()?;
-    Ok(gouraud_mesh_scene(&mesh, view, subdivisions))
+    gouraud_mesh_scene(&mesh, view, subdivisions)
 }
 
 /// A mesh framed like `render --obj` (or seen as `view` says), split
 /// `subdivisions` times, with per-vertex head-light Lambert colours.
-pub fn gouraud_mesh_scene(mesh: &obj::LoadedMesh, view: &View, subdivisions: u32) -> Scene {
+pub fn gouraud_mesh_scene(
+    mesh: &obj::LoadedMesh,
+    view: &View,
+    subdivisions: u32,
+) -> Result<Scene, String> {
     let fov = view.fov.unwrap_or(60.0);
     let (fe, ft) = obj::frame_camera(mesh, fov, view.aspect());
     let (eye, target) = (view.eye.unwrap_or(fe), view.target.unwrap_or(ft));
@@ -355,14 +330,14 @@ pub fn gouraud_mesh_scene(mesh: &obj::LoadedMesh, view: &View, subdivisions: u32
     }
     // The camera, near and far planes and bounds as `render --obj` has them
     // (only the colours differ), from the original mesh.
-    let mut scene = render::mesh_scene(
+    let mut scene = scene::mesh_scene(
         &mesh.positions,
         &mesh.indices,
         eye,
         target,
         fov,
         view.aspect(),
-    );
+    )?;
     let light = (Vec3::from_array(eye) - Vec3::from_array(target)).normalize();
     let colors = vertex_normals(&positions, &indices)
         .iter()
@@ -377,7 +352,7 @@ pub fn gouraud_mesh_scene(mesh: &obj::LoadedMesh, view: &View, subdivisions: u32
         o.indices = indices;
         o.colors = ObjectColors::PerVertex(colors);
     }
-    scene
+    Ok(scene)
 }
 
 /// Two flat triangles covering the whole frame at NDC depth 0 (window
@@ -468,7 +443,7 @@ mod tests {
     #[test]
     fn sphere_scene_renders_a_disc_of_front_faces() {
         let view = View::new(240, 320);
-        let (mut scene, spin) = sphere_scene(&view, 100, 100);
+        let (mut scene, spin) = sphere_scene(&view, 100, 100).unwrap();
         let r = render(&scene, &opts(240, 320, DepthKind::U16)).unwrap();
         let s = r.stats;
         assert_eq!(s.submitted, 20_000);

@@ -8,7 +8,14 @@
 //! names a supported format. `--obj`, `--clip-tris` and an explicit `--scene`
 //! are mutually exclusive; [`RenderArgs::source`] says which one to use.
 //! Vectors are written `X,Y,Z`; negative values work both as `--eye -1,2,3`
-//! and `--eye=-1,2,3`.
+//! and `--eye=-1,2,3`, and `--fov -5` reaches the range check instead of
+//! being taken for an option.
+//!
+//! Every subcommand's options are defined here ([`RenderArgs`],
+//! [`BenchArgs`], [`ReportArgs`]), so data flows one way: this module
+//! parses, and the command modules (`render_cmd`, `bench`, `report`) take
+//! what it made; it imports none of them. Checks that need the scene (a
+//! camera for a scene without one, eye equal to target) are the command's.
 
 use std::path::PathBuf;
 
@@ -20,6 +27,9 @@ use crate::image_out::{image_format, MAX_DIMENSION};
 /// Names accepted by `--scene`.
 /// (`crate::bench_scenes` builds them; see there for what each one is.)
 pub const SCENES: [&str; 5] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad"];
+
+/// The scenes of `report speed-vs-error`, in order.
+pub const REPORT_SCENES: [&str; 4] = ["cubes", "spot", "teapot", "bunny"];
 
 /// Largest `--threads` value accepted.
 pub const MAX_THREADS: usize = 1024;
@@ -37,12 +47,35 @@ pub struct Cli {
 #[derive(Subcommand, Debug, Clone)]
 pub enum Command {
     /// Render a built-in scene, an OBJ mesh or clip-space triangles to an image.
+    #[command(after_help = RENDER_SOURCES_HELP)]
     Render(RenderArgs),
     /// Render a scene repeatedly and print timings as JSON (see `bench --help`).
-    Bench(crate::bench::BenchArgs),
-    /// Write reports, e.g. `report speed-vs-error OUT_DIR`.
-    Report(crate::report::ReportArgs),
+    #[command(after_help = BENCH_PROGRESS_HELP)]
+    Bench(BenchArgs),
+    /// Write reports, e.g. `report speed-vs-error OUT_DIR` (needs the
+    /// `report` feature).
+    Report(ReportArgs),
 }
+
+/// The end of `render --help`: which options each source uses.
+pub const RENDER_SOURCES_HELP: &str = "\
+Which options each source uses:
+  --scene cubes         --eye, --target, --fov (default: eye 0,3.75,6.5, target 0,0,0, 60°)
+  --scene sphere        --eye, --target, --fov (default: eye at the origin looking down -z, 45°)
+  --scene bunny, --scene bunny-subdiv, --obj FILE
+                        --eye, --target, --fov (default: framed to fit, 60°)
+  --scene quad          no camera: clip-space triangles; --eye, --target, --fov are refused
+  --clip-tris FILE      no camera: clip-space triangles; --eye, --target, --fov are refused
+Every source uses --size, --threads, --strip-rows, --cull, --depth, --subpixel and the
+outputs (--out, --id-out, --depth-out, --stats, --checksum). A camera looking straight
+up or down gets -z or +z as its up vector. A render that draws no pixel, or drops
+triangles, says so on stderr with the core's counters.";
+
+/// The end of `bench --help`: progress output.
+pub const BENCH_PROGRESS_HELP: &str = "\
+Progress: runs that take over a few seconds report progress on stderr, on one
+updating line on a terminal and as plain lines otherwise (every
+MICRORASTER_PROGRESS_MS milliseconds, default 2000). The JSON on stdout is unchanged.";
 
 /// Which triangles face away and are skipped.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,9 +140,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<[f32; 3]>,
 
-    /// Vertical field of view in degrees.
-    #[arg(long, value_name = "DEG", default_value = "60", value_parser = parse_fov)]
-    pub fov: f32,
+    /// Vertical field of view in degrees [default: 45 for sphere, else 60].
+    #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true)]
+    pub fov: Option<f32>,
 
     /// Image size in pixels.
     #[arg(long, value_name = "WxH", default_value = "800x600", value_parser = parse_size)]
@@ -183,6 +216,205 @@ impl RenderArgs {
         self.size.0 as f32 / self.size.1 as f32
     }
 }
+
+/// Colour format of the benchmark's frame buffer.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorArg {
+    /// 24-bit RGB (`Rgb888`), as `render` draws.
+    Rgb888,
+    /// 16-bit RGB565 (`Rgb565`), as small displays take.
+    Rgb565,
+}
+
+/// A list of thread counts, `N[,N...]`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ThreadList(pub Vec<usize>);
+
+/// Parses `--threads`: one count or a comma-separated list, each in
+/// 1..=[`MAX_THREADS`].
+pub fn parse_thread_list(s: &str) -> Result<ThreadList, String> {
+    let list = s
+        .split(',')
+        .map(parse_threads)
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(ThreadList(list))
+}
+
+fn parse_frames(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if (1..=1_000_000).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "frames must be a whole number in 1..=1000000, got {s:?}"
+        )),
+    }
+}
+
+fn parse_warmup(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if n <= 1_000_000 => Ok(n),
+        _ => Err(format!(
+            "warm-up frames must be a whole number in 0..=1000000, got {s:?}"
+        )),
+    }
+}
+
+fn parse_spin(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(d) if d.is_finite() && d.abs() <= 360.0 => Ok(d),
+        _ => Err(format!(
+            "spin must be degrees per frame in -360..=360, got {s:?}"
+        )),
+    }
+}
+
+/// Options of `microraster bench`.
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct BenchArgs {
+    /// Built-in scene: cubes (800x600), sphere (tgx's 20,000-triangle
+    /// sphere, 240x320, 1 thread, u16 depth, RGB565), bunny (69,451
+    /// triangles, 1920x1080), bunny-subdiv (1,111,216 triangles, 1920x1080),
+    /// quad (two triangles, 1920x1080, with the memory floor).
+    #[arg(
+        long,
+        value_name = "NAME",
+        default_value = "cubes",
+        value_parser = PossibleValuesParser::new(SCENES),
+        conflicts_with = "obj"
+    )]
+    pub scene: String,
+
+    /// Benchmark this Wavefront OBJ mesh (framed and flat-shaded as by
+    /// `render --obj`) instead of a scene.
+    #[arg(long, value_name = "FILE")]
+    pub obj: Option<PathBuf>,
+
+    /// Camera position (default: the scene's, or framed to fit the mesh).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<[f32; 3]>,
+
+    /// Point the camera looks at.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<[f32; 3]>,
+
+    /// Vertical field of view in degrees [default: 45 for sphere, else 60].
+    #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true)]
+    pub fov: Option<f32>,
+
+    /// Image size in pixels [default: the scene's; 800x600 for --obj].
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+
+    /// Worker threads, or a list (`1,2,4`) for a scaling run [default: 1
+    /// for sphere, else all cores].
+    #[arg(long, value_name = "N[,N...]", value_parser = parse_thread_list)]
+    pub threads: Option<ThreadList>,
+
+    /// Thread scaling: one run for each thread count 1..=cores.
+    #[arg(long, conflicts_with = "threads")]
+    pub scaling: bool,
+
+    /// Rows per strip.
+    #[arg(long, value_name = "R", default_value = "16", value_parser = parse_strip_rows)]
+    pub strip_rows: u32,
+
+    /// Face culling.
+    #[arg(long, value_enum, default_value_t = CullArg::Back)]
+    pub cull: CullArg,
+
+    /// Depth buffer format [default: u16 for sphere, else u32].
+    #[arg(long, value_enum)]
+    pub depth: Option<DepthArg>,
+
+    /// Colour format [default: rgb565 for sphere, else rgb888].
+    #[arg(long, value_enum)]
+    pub color: Option<ColorArg>,
+
+    /// Sub-pixel precision in bits (4 or 8).
+    #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
+    pub subpixel: u32,
+
+    /// Timed frames per run.
+    #[arg(long, value_name = "N", default_value = "50", value_parser = parse_frames)]
+    pub frames: u32,
+
+    /// Untimed frames before the timed ones.
+    #[arg(long, value_name = "N", default_value = "5", value_parser = parse_warmup)]
+    pub warmup: u32,
+
+    /// Turn the model about y by this many degrees per frame [default: 1
+    /// for sphere, else 0].
+    #[arg(long, value_name = "DEG", value_parser = parse_spin, allow_hyphen_values = true)]
+    pub spin: Option<f32>,
+
+    /// Also run the peers (euc, embedded-graphics) on the same scene, one
+    /// thread, and print the ratios (needs the `peers` feature).
+    #[arg(long)]
+    pub peers: bool,
+
+    /// Also measure the memory floor (always on for the quad scene).
+    #[arg(long)]
+    pub floor: bool,
+
+    /// Skip the stage split of mesh scenes.
+    #[arg(long)]
+    pub no_split: bool,
+
+    /// Print the JSON on one line.
+    #[arg(long)]
+    pub compact: bool,
+
+    /// Also time `render::render` itself frame by frame (allocations and
+    /// RGB8 output included), next to the buffer-reusing loop.
+    #[arg(long)]
+    pub render_fn: bool,
+
+    /// Write the last frame of the first run to this image (.png or .ppm).
+    #[arg(long, value_name = "FILE", value_parser = parse_image_path)]
+    pub out: Option<PathBuf>,
+}
+
+/// Options of `microraster report` (needs the `report` feature).
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct ReportArgs {
+    /// Which report: `speed-vs-error`.
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["speed-vs-error"]))]
+    pub which: String,
+
+    /// Folder for the report's files (created if missing).
+    #[arg(value_name = "OUT_DIR")]
+    pub out_dir: PathBuf,
+
+    /// A quick run for CI: 160x120, 3 repetitions.
+    #[arg(long)]
+    pub quick: bool,
+
+    /// Image size (default 800x600, or 160x120 with --quick).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+
+    /// Timed frames per configuration and scene; the median is reported
+    /// (default 7, or 3 with --quick).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub reps: Option<u32>,
+
+    /// Scenes to run, comma-separated (default: all of cubes, spot, teapot,
+    /// bunny).
+    #[arg(long, value_name = "LIST", value_delimiter = ',',
+          value_parser = clap::builder::PossibleValuesParser::new(REPORT_SCENES))]
+    pub scenes: Option<Vec<String>>,
+
+    /// Folder holding spot.obj, teapot.obj and stanford-bunny.obj (default:
+    /// the repository's assets/models).
+    #[arg(long, value_name = "DIR")]
+    pub models: Option<PathBuf>,
+
+    /// Do not show the progress bar.
+    #[arg(long)]
+    pub no_progress: bool,
+}
+
+/// The scenes of the report, in order.
+pub const SCENE_NAMES: [&str; 4] = ["cubes", "spot", "teapot", "bunny"];
 
 /// Default for `--threads`: the machine's available parallelism, else 1.
 pub fn default_threads() -> usize {
@@ -294,32 +526,6 @@ pub fn parse_png_path(s: &str) -> Result<PathBuf, String> {
     }
 }
 
-/// Checks that `eye`, `target` and `up` make a usable look-at camera: the eye
-/// differs from the target and the view direction is not parallel to `up`.
-pub fn check_camera(eye: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Result<(), String> {
-    let d = [0, 1, 2].map(|k| f64::from(target[k]) - f64::from(eye[k]));
-    let u = up.map(f64::from);
-    let len2 = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>();
-    let dd = len2(d);
-    if !dd.is_finite() || dd <= 0.0 {
-        return Err("the camera eye and target must be distinct finite points".to_string());
-    }
-    let c = [
-        d[1] * u[2] - d[2] * u[1],
-        d[2] * u[0] - d[0] * u[2],
-        d[0] * u[1] - d[1] * u[0],
-    ];
-    // |d x u|^2 = |d|^2 |u|^2 sin^2: parallel if sin is (almost) zero, and a
-    // zero or non-finite `up` fails the same test.
-    let cc = len2(c);
-    if !cc.is_finite() || cc <= 1e-12 * dd * len2(u) || len2(u) <= 0.0 {
-        return Err(format!(
-            "the view direction from {eye:?} to {target:?} is parallel to up {up:?}"
-        ));
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -348,7 +554,7 @@ mod tests {
         assert_eq!(r.clip_tris, None);
         assert_eq!(r.eye, None);
         assert_eq!(r.target, None);
-        assert_eq!(r.fov, 60.0);
+        assert_eq!(r.fov, None);
         assert_eq!(r.size, (800, 600));
         assert_eq!((r.width(), r.height()), (800, 600));
         assert!((r.aspect() - 4.0 / 3.0).abs() < 1e-6);
@@ -399,7 +605,7 @@ mod tests {
         assert_eq!(r.source(), Source::Obj("m.obj".into()));
         assert_eq!(r.eye, Some([-1.0, 2.5, 3.0]));
         assert_eq!(r.target, Some([0.0, 0.0, -10.0]));
-        assert_eq!(r.fov, 45.5);
+        assert_eq!(r.fov, Some(45.5));
         assert_eq!(r.size, (640, 480));
         assert_eq!(r.threads, 3);
         assert_eq!(r.strip_rows, 1);
@@ -482,17 +688,5 @@ mod tests {
         assert!(parse_image_path("a.gif").is_err());
         assert!(parse_png_path("a.PNG").is_ok());
         assert!(parse_png_path("a.ppm").is_err());
-    }
-
-    #[test]
-    fn camera_check() {
-        let up = [0.0, 1.0, 0.0];
-        assert!(check_camera([0.0, 3.75, 6.5], [0.0; 3], up).is_ok());
-        assert!(check_camera([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], up).is_err());
-        assert!(check_camera([0.0, 5.0, 0.0], [0.0; 3], up).is_err());
-        assert!(check_camera([0.0, -5.0, 0.0], [0.0; 3], up).is_err());
-        assert!(check_camera([f32::NAN, 0.0, 0.0], [0.0; 3], up).is_err());
-        assert!(check_camera([f32::MAX, 0.0, 0.0], [-f32::MAX, 0.0, 0.0], up).is_ok());
-        assert!(check_camera([0.0, 0.0, 1.0], [0.0; 3], [0.0; 3]).is_err());
     }
 }

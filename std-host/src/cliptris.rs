@@ -88,7 +88,13 @@ fn parse_line(line: &str) -> Result<Option<ClipTri>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_util::TempDir;
+    use tempfile::TempDir;
+
+    fn write_file(dir: &TempDir, name: &str, text: &str) -> std::path::PathBuf {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
 
     const TRI: &str = "0 0 0 1  1 0 0 1  0 1 0 1";
 
@@ -184,10 +190,10 @@ mod tests {
 
     #[test]
     fn load_from_file() {
-        let dir = TempDir::new("cliptris");
-        let ok = dir.write("ok.txt", &format!("{TRI} 10 20 30\n"));
+        let dir = TempDir::new().unwrap();
+        let ok = write_file(&dir, "ok.txt", &format!("{TRI} 10 20 30\n"));
         assert_eq!(load_clip_tris(&ok).unwrap()[0].color, Some([10, 20, 30]));
-        let bad = dir.write("bad.txt", "1 2\n");
+        let bad = write_file(&dir, "bad.txt", "1 2\n");
         let e = load_clip_tris(&bad).unwrap_err();
         assert!(e.contains("bad.txt") && e.contains("line 1"), "{e}");
         let e = load_clip_tris(&dir.path().join("missing.txt")).unwrap_err();

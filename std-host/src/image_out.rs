@@ -110,7 +110,18 @@ fn write_ppm(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), Str
 /// Writes a tightly packed 8-bit RGB image (`width * height * 3` bytes, rows
 /// top to bottom) as PNG or binary PPM, chosen by the extension of `path`.
 pub fn write_rgb(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
-    let format = image_format(path)?;
+    write_rgb_as(path, image_format(path)?, width, height, rgb)
+}
+
+/// [`write_rgb`] in `format`, whatever the extension of `path` (for a
+/// temporary file that is renamed afterwards).
+pub fn write_rgb_as(
+    path: &Path,
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> Result<(), String> {
     check_buffer(path, width, height, 3, rgb.len())?;
     match format {
         ImageFormat::Png => write_png(path, width, height, png::ColorType::Rgb, rgb),
@@ -133,7 +144,7 @@ pub fn write_raw(path: &Path, bytes: &[u8]) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_util::TempDir;
+    use tempfile::TempDir;
 
     fn read_png(path: &Path) -> (png::OutputInfo, Vec<u8>) {
         let bytes = std::fs::read(path).unwrap();
@@ -162,7 +173,7 @@ mod tests {
 
     #[test]
     fn png_rgb_round_trip() {
-        let dir = TempDir::new("png_rgb");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("out.png");
         let data = pattern(5 * 3 * 3);
         write_rgb(&path, 5, 3, &data).unwrap();
@@ -175,7 +186,7 @@ mod tests {
 
     #[test]
     fn png_rgba_round_trip() {
-        let dir = TempDir::new("png_rgba");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("ids.png");
         let data = pattern(4 * 7 * 4);
         write_rgba_png(&path, 4, 7, &data).unwrap();
@@ -187,7 +198,7 @@ mod tests {
 
     #[test]
     fn ppm_header_and_body() {
-        let dir = TempDir::new("ppm");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("out.PPM");
         let data = pattern(2 * 3 * 3);
         write_rgb(&path, 2, 3, &data).unwrap();
@@ -199,7 +210,7 @@ mod tests {
 
     #[test]
     fn raw_round_trip() {
-        let dir = TempDir::new("raw");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("depth.bin");
         let data = pattern(100);
         write_raw(&path, &data).unwrap();
@@ -208,7 +219,7 @@ mod tests {
 
     #[test]
     fn size_mismatch_is_an_error_and_writes_nothing() {
-        let dir = TempDir::new("mismatch");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("bad.png");
         let e = write_rgb(&path, 4, 4, &[0; 47]).unwrap_err();
         assert!(e.contains("47") && e.contains("48"), "{e}");
@@ -222,7 +233,7 @@ mod tests {
 
     #[test]
     fn bad_dimensions_and_extension_are_errors() {
-        let dir = TempDir::new("baddims");
+        let dir = TempDir::new().unwrap();
         assert!(write_rgb(&dir.path().join("a.png"), 0, 4, &[]).is_err());
         assert!(write_rgb(&dir.path().join("a.png"), 4, 0, &[]).is_err());
         assert!(write_rgb(&dir.path().join("a.ppm"), MAX_DIMENSION + 1, 1, &[]).is_err());
@@ -233,7 +244,7 @@ mod tests {
 
     #[test]
     fn unwritable_path_is_an_error() {
-        let dir = TempDir::new("unwritable");
+        let dir = TempDir::new().unwrap();
         let path = dir.path().join("no/such/dir/x.png");
         let e = write_rgb(&path, 1, 1, &[1, 2, 3]).unwrap_err();
         assert!(e.contains("x.png"), "{e}");

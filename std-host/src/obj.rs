@@ -10,6 +10,13 @@
 //! positions only, so one `nan` vertex does not poison the automatic camera;
 //! such vertices stay in the mesh for the renderer to reject.
 //!
+//! tobj's errors carry no line number, so when it fails the file is
+//! scanned again by [`locate_error`], a light check of the same statements
+//! (`v`, `vt`, `vn`, `f`, `l`): the first line that tobj's error matches is
+//! reported with its number and text, so the message says what to fix and
+//! where ("teapot.obj: line 12: ... `f 1 2 x`"). The scan runs only on the
+//! error path and never decides whether a file loads.
+//!
 //! [`frame_camera`] places the eye on the `(0, 0.3, 1)` side of the mesh's
 //! bounding sphere at the distance where the sphere (plus a 10% margin) fits
 //! both the vertical and the horizontal field of view.
@@ -48,12 +55,90 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| format!("{}: cannot load OBJ file: {e}", path.display()))?;
+    .map_err(|e| describe_load_error(path, &e))?;
     let meshes: Vec<(&[f32], &[u32])> = models
         .iter()
         .map(|m| (m.mesh.positions.as_slice(), m.mesh.indices.as_slice()))
         .collect();
     merge_meshes(&meshes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// tobj's error `e` for `path`, with the line it most likely comes from.
+fn describe_load_error(path: &Path, e: &tobj::LoadError) -> String {
+    let text = std::fs::read(path)
+        .map(|b| String::from_utf8_lossy(&b).into_owned())
+        .unwrap_or_default();
+    match locate_error(&text, e) {
+        Some((line, what)) => format!("{}: line {line}: {what} ({e})", path.display()),
+        None => format!("{}: cannot load OBJ file: {e}", path.display()),
+    }
+}
+
+/// The first line (1-based) of the OBJ `text` showing the problem tobj
+/// reported as `e`, and what is wrong there.
+pub fn locate_error(text: &str, e: &tobj::LoadError) -> Option<(usize, String)> {
+    use tobj::LoadError as E;
+    let floats = |toks: &[&str]| toks.iter().all(|t| t.parse::<f32>().is_ok());
+    let total_v = text
+        .lines()
+        .filter(|l| l.split_whitespace().next() == Some("v"))
+        .count() as i64;
+    let mut seen_v = 0i64;
+    for (n, line) in text.lines().enumerate() {
+        let toks: Vec<&str> = line.split_whitespace().collect();
+        let Some((&kind, args)) = toks.split_first() else {
+            continue;
+        };
+        let quoted = format!("`{}`", line.trim());
+        let problem = match (kind, e) {
+            ("v", E::PositionParseError) if args.len() < 3 || !floats(&args[..3]) => {
+                Some(format!("a vertex needs three numbers x y z: {quoted}"))
+            }
+            ("v", E::PositionParseError) if args.len() == 4 && !floats(&args[3..]) => {
+                Some(format!("the vertex weight w is not a number: {quoted}"))
+            }
+            ("v", E::ScalingByZeroError) if args.len() == 4 && args[3].parse() == Ok(0.0f32) => {
+                Some(format!("the vertex weight w is zero: {quoted}"))
+            }
+            ("v", E::ColorParseError) if args.len() == 5 || args.len() > 6 => Some(format!(
+                "a vertex has x y z, then nothing, a weight w or a colour r g b: {quoted}"
+            )),
+            ("vt", E::TexcoordParseError) if args.len() < 2 || !floats(&args[..2]) => {
+                Some(format!("a texture coordinate needs two numbers: {quoted}"))
+            }
+            ("vn", E::NormalParseError) if args.len() < 3 || !floats(&args[..3]) => {
+                Some(format!("a normal needs three numbers: {quoted}"))
+            }
+            ("f" | "l", E::FaceParseError | E::FaceVertexOutOfBounds) => {
+                args.iter().find_map(|a| {
+                    let first = a.split('/').next().unwrap_or("");
+                    match first.parse::<i64>() {
+                        Err(_) => Some(format!(
+                            "{first:?} is not a vertex index (whole numbers from 1, or \
+                             negative to count back): {quoted}"
+                        )),
+                        Ok(0) => Some(format!("vertex indices start at 1, not 0: {quoted}")),
+                        Ok(i) if i < 0 && -i > seen_v => Some(format!(
+                            "vertex index {i} reaches back past the {seen_v} vertices \
+                             before this line: {quoted}"
+                        )),
+                        Ok(i) if i > total_v => Some(format!(
+                            "vertex index {i} is past the file's {total_v} vertices: {quoted}"
+                        )),
+                        Ok(_) => None,
+                    }
+                })
+            }
+            _ => None,
+        };
+        if kind == "v" {
+            seen_v += 1;
+        }
+        if let Some(p) = problem {
+            return Some((n + 1, p));
+        }
+    }
+    None
 }
 
 /// Merges flat `(positions, indices)` pairs (as `tobj` returns them) into one
@@ -169,11 +254,17 @@ pub fn frame_camera(mesh: &LoadedMesh, fov_y_deg: f32, aspect: f32) -> ([f32; 3]
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_util::TempDir;
+    use tempfile::TempDir;
+
+    fn write_file(dir: &TempDir, name: &str, text: &str) -> std::path::PathBuf {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
 
     fn load_text(text: &str) -> Result<LoadedMesh, String> {
-        let dir = TempDir::new("obj");
-        let path = dir.write("mesh.obj", text);
+        let dir = TempDir::new().unwrap();
+        let path = write_file(&dir, "mesh.obj", text);
         load_obj(&path)
     }
 
@@ -246,6 +337,34 @@ mod tests {
             let e = load_text(text).expect_err(what);
             assert!(e.contains("mesh.obj"), "{what}: {e}");
         }
+        let e = load_obj(Path::new("/nonexistent/dir/thing.obj")).unwrap_err();
+        assert!(e.contains("thing.obj"), "{e}");
+    }
+
+    #[test]
+    fn load_errors_name_the_line() {
+        let cases = [
+            ("v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n", "line 2:"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 x\n", "line 5:"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n", "line 5:"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "line 4:"),
+            ("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", "line 3:"),
+            ("v 0 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1:"),
+            ("vn 0 1\nv 0 0 0\n", "line 1:"),
+        ];
+        for (text, want) in cases {
+            let e = load_text(text).unwrap_err();
+            assert!(e.contains("mesh.obj") && e.contains(want), "{text:?}: {e}");
+        }
+        // The scan finds nothing where tobj's error does not match a line.
+        assert_eq!(
+            locate_error("v 0 0 0\n", &tobj::LoadError::GenericFailure),
+            None
+        );
+    }
+
+    #[test]
+    fn missing_file_names_the_path() {
         let e = load_obj(Path::new("/nonexistent/dir/thing.obj")).unwrap_err();
         assert!(e.contains("thing.obj"), "{e}");
     }

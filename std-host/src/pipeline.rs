@@ -19,11 +19,11 @@
 //! submission order, so the image is byte-identical for any thread count and
 //! any strip height.
 
-use crate::render::{ObjectColors, Scene};
+use crate::scene::{ObjectColors, Scene};
 use microraster::prelude::Submit;
 use microraster::{
-    Bins, ClipVertex, Config, Error, Frame, MeshColors, NoDepth, PixelFormat, ProcessedVertex,
-    SetupTriangle, Stats, Vec4,
+    Bins, ClipVertex, Config, DepthWord, Error, Frame, MeshColors, NoDepth, PixelFormat,
+    ProcessedVertex, SetupTriangle, Stats, Vec4,
 };
 use std::ops::Range;
 use std::sync::Mutex;
@@ -140,41 +140,6 @@ pub fn fill<const S: u32>(
 // ---------------------------------------------------------------------------
 // Strips.
 
-/// A depth format to draw strips with.
-pub trait DepthFormat: Copy + Send + Sync + 'static {
-    /// The cleared (farthest) value.
-    const CLEAR: Self;
-    /// `frame.render_strip` with this depth slice; the pixels written.
-    fn render_strip<const S: u32, C: PixelFormat>(
-        frame: &Frame<'_, S>,
-        bins: &Bins<'_>,
-        strip: u32,
-        color: &mut [C],
-        depth: &mut [Self],
-    ) -> Result<u64, Error>;
-}
-
-macro_rules! depth_format {
-    ($t:ty) => {
-        impl DepthFormat for $t {
-            const CLEAR: Self = <$t>::MAX;
-            fn render_strip<const S: u32, C: PixelFormat>(
-                frame: &Frame<'_, S>,
-                bins: &Bins<'_>,
-                strip: u32,
-                color: &mut [C],
-                depth: &mut [$t],
-            ) -> Result<u64, Error> {
-                Ok(frame
-                    .render_strip(bins, strip, color, depth)?
-                    .pixels_written)
-            }
-        }
-    };
-}
-depth_format!(u16);
-depth_format!(u32);
-
 /// One strip: its first row and its rows of colour and depth.
 type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
 
@@ -251,9 +216,9 @@ pub type Layer<'a, 'f, const S: u32> = (&'a Frame<'f, S>, &'a Bins<'a>);
 
 /// Draws every strip of the binned frames `layers` (in order, binned into
 /// strips of `rows` rows) on `threads` workers, clearing each strip first
-/// (colour to `clear`, depth to [`DepthFormat::CLEAR`]) if `clear` is given.
+/// (colour to `clear`, depth to [`DepthWord::FAR`]) if `clear` is given.
 /// Returns the pixels written.
-pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthFormat>(
+pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
     layers: &[Layer<'_, '_, S>],
     color: &mut [C],
     depth: Option<&mut [T]>,
@@ -277,13 +242,13 @@ pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthFormat>(
             if let Some(v) = clear {
                 c.fill(v);
                 if let Some(d) = d.as_deref_mut() {
-                    d.fill(T::CLEAR);
+                    d.fill(T::FAR);
                 }
             }
             let mut written = 0;
             for (frame, bins) in layers {
                 written += match d.as_deref_mut() {
-                    Some(d) => T::render_strip(frame, bins, strip, c, d)?,
+                    Some(d) => frame.render_strip(bins, strip, c, d)?.pixels_written,
                     None => {
                         frame
                             .render_strip(bins, strip, c, &mut NoDepth)?
@@ -487,8 +452,8 @@ impl<const S: u32> FramePipeline<S> {
         storages.resize_with(chunks.len(), Vec::new);
         for (storage, pieces) in storages.iter_mut().zip(&chunks) {
             let n: usize = pieces.iter().map(Piece::len).sum();
-            if storage.len() < n + n / 8 + 64 {
-                storage.resize(n + n / 8 + 64, SetupTriangle::EMPTY);
+            if storage.len() < Frame::<S>::storage_for(n) {
+                storage.resize(Frame::<S>::storage_for(n), SetupTriangle::EMPTY);
             }
         }
         // Every chunk is built once. A chunk whose storage was too small
@@ -578,7 +543,7 @@ impl<const S: u32> FramePipeline<S> {
     /// Renders one frame of `scene` into `color` and `depth` (cleared
     /// first, strip by strip). Returns the setup times, the raster time in
     /// milliseconds and the pixels written.
-    pub fn render<C: PixelFormat + Send + Sync, T: DepthFormat>(
+    pub fn render<C: PixelFormat + Send + Sync, T: DepthWord>(
         &mut self,
         scene: &Scene,
         color: &mut [C],
@@ -604,7 +569,7 @@ fn ms(t: Instant) -> f64 {
 mod tests {
     use super::*;
     use crate::cliptris::ClipTri;
-    use crate::render::{clip_tris_scene, cubes_scene};
+    use crate::scene::{clip_tris_scene, cubes_scene, View};
     use microraster::pixelcolor::{Rgb888, RgbColor};
     use microraster::CullMode;
 
@@ -641,7 +606,7 @@ mod tests {
 
     #[test]
     fn partition_covers_the_scene_in_order() {
-        let mut scene = cubes_scene(32, 24);
+        let mut scene = cubes_scene(&View::new(32, 24)).unwrap();
         scene.clip_tris = (0..10).map(small).collect();
         for parts in [1, 2, 3, 7, 100] {
             let chunks = partition(&scene, parts);
@@ -701,7 +666,7 @@ mod tests {
         for threads in [1, 2, 3] {
             let mut pipe = FramePipeline::<8>::new(config(), threads, 5);
             let mut color = vec![Rgb888::BLACK; 64 * 48];
-            let mut depth = vec![u32::CLEAR; 64 * 48];
+            let mut depth = vec![u32::MAX; 64 * 48];
             let (setup, _, px) = pipe
                 .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
                 .unwrap();
@@ -711,7 +676,7 @@ mod tests {
             let guesses: Vec<usize> = partition(&scene, threads)
                 .iter()
                 .map(|c| c.iter().map(Piece::len).sum::<usize>())
-                .map(|n| n + n / 8 + 64)
+                .map(Frame::<8>::storage_for)
                 .collect();
             assert_eq!(pipe.storages.len(), threads);
             if threads > 1 {

@@ -1,7 +1,6 @@
-//! Scenes and threaded strip rendering on top of the core.
+//! Threaded strip rendering of a [`Scene`] into owned images.
 //!
-//! Design note: a [`Scene`] is plain owned data (meshes with their
-//! model-view-projection matrix, or raw clip-space triangles). [`render`]
+//! Design note: [`render`]
 //! hands it to a fresh [`FramePipeline`], which sets every triangle up once
 //! into binned core frames (see [`crate::pipeline`]: one frame per setup
 //! thread from 20,000 triangles up, storage sized from the triangle count
@@ -13,158 +12,15 @@
 //! triangles in submission order in every strip, so the image is
 //! byte-identical for any thread count and any strip height.
 
-use crate::cliptris::ClipTri;
-use crate::pipeline::{draw_layers, DepthFormat, FramePipeline, Layer};
+use crate::pipeline::{draw_layers, FramePipeline, Layer};
+use crate::scene::Scene;
 use microraster::pixelcolor::{Rgb888, RgbColor};
-use microraster::{
-    BoundingSphere, Config, CullMode, Mat4, Mesh, MeshColors, PixelFormat, Stats, TriangleId, Vec3,
-};
+use microraster::{Config, CullMode, PixelFormat, Stats, TriangleId};
+use serde::Serialize;
 use std::time::Instant;
 
 /// The background colour of rendered images.
 pub const BACKGROUND: Rgb888 = Rgb888::new(0, 0, 0);
-
-/// One mesh to draw, with its own transform to clip space.
-#[derive(Clone, Debug)]
-pub struct Object {
-    /// Object-space positions.
-    pub positions: Vec<Vec3>,
-    /// Triangles.
-    pub indices: Vec<[u32; 3]>,
-    /// Colours: per triangle (flat) or per vertex (Gouraud).
-    pub colors: ObjectColors,
-    /// Bounding sphere for whole-object culling.
-    pub bounds: Option<BoundingSphere>,
-    /// Object to clip space.
-    pub mvp: Mat4,
-}
-
-/// The colours of an [`Object`].
-#[derive(Clone, Debug)]
-pub enum ObjectColors {
-    /// One colour per triangle (flat shading).
-    PerTriangle(Vec<Rgb888>),
-    /// One colour per vertex (Gouraud shading, perspective-correct).
-    PerVertex(Vec<Rgb888>),
-}
-
-impl ObjectColors {
-    /// As the core's [`MeshColors`].
-    pub fn as_mesh_colors(&self) -> MeshColors<'_> {
-        match self {
-            ObjectColors::PerTriangle(c) => MeshColors::PerTriangle(c),
-            ObjectColors::PerVertex(c) => MeshColors::PerVertex(c),
-        }
-    }
-}
-
-impl Object {
-    /// As the core's [`Mesh`].
-    pub fn mesh(&self) -> Mesh<'_> {
-        Mesh {
-            positions: &self.positions,
-            indices: &self.indices,
-            colors: self.colors.as_mesh_colors(),
-            bounds: self.bounds,
-        }
-    }
-}
-
-/// Everything to draw in one frame, in drawing order: objects first, then
-/// clip-space triangles. Triangle ids count from 0 in that order.
-#[derive(Clone, Debug, Default)]
-pub struct Scene {
-    /// Meshes.
-    pub objects: Vec<Object>,
-    /// Raw clip-space triangles.
-    pub clip_tris: Vec<ClipTri>,
-}
-
-impl Scene {
-    /// The number of input triangles.
-    pub fn triangle_count(&self) -> usize {
-        self.objects.iter().map(|o| o.indices.len()).sum::<usize>() + self.clip_tris.len()
-    }
-}
-
-fn v3(a: [f32; 3]) -> Vec3 {
-    Vec3::from_array(a)
-}
-
-/// The default scene: four cubes, a colour per face, camera at
-/// (0, 3.75, 6.5) looking at the origin, 60° vertical field of view (see
-/// [`crate::cubes`]).
-pub fn cubes_scene(width: u32, height: u32) -> Scene {
-    let mut objects = Vec::new();
-    crate::cubes::for_each_cube(width, height, |mesh, mvp, _| {
-        let colors = match mesh.colors {
-            MeshColors::PerTriangle(c) => ObjectColors::PerTriangle(c.to_vec()),
-            MeshColors::PerVertex(c) => ObjectColors::PerVertex(c.to_vec()),
-            MeshColors::Uniform(c) => ObjectColors::PerTriangle(vec![c; mesh.indices.len()]),
-        };
-        objects.push(Object {
-            positions: mesh.positions.to_vec(),
-            indices: mesh.indices.to_vec(),
-            colors,
-            bounds: mesh.bounds,
-            mvp: *mvp,
-        });
-    });
-    Scene {
-        objects,
-        clip_tris: Vec::new(),
-    }
-}
-
-/// A mesh seen from `eye` towards `target`, flat-shaded with a head light
-/// (Lambert, per triangle, computed here on the host).
-pub fn mesh_scene(
-    positions: &[[f32; 3]],
-    indices: &[[u32; 3]],
-    eye: [f32; 3],
-    target: [f32; 3],
-    fov_y_deg: f32,
-    aspect: f32,
-) -> Scene {
-    let positions: Vec<Vec3> = positions.iter().map(|&p| v3(p)).collect();
-    let bounds = BoundingSphere::from_points(&positions);
-    let (eye, target) = (v3(eye), v3(target));
-    let dist = (target - eye).length();
-    let radius = bounds.map(|b| b.radius).unwrap_or(1.0);
-    let near = (dist - 2.0 * radius).max(dist * 0.01).max(1e-4);
-    let far = (dist + 2.0 * radius).max(near * 2.0);
-    let proj = Mat4::perspective(microraster::math::radians(fov_y_deg), aspect, near, far);
-    let view = Mat4::look_at(eye, target, Vec3::new(0.0, 1.0, 0.0));
-    let light = (eye - target).normalize();
-    let colors = indices
-        .iter()
-        .map(|t| {
-            let p = |k: usize| positions.get(t[k] as usize).copied().unwrap_or(Vec3::ZERO);
-            let n = (p(1) - p(0)).cross(p(2) - p(0)).normalize();
-            let lambert = n.dot(light).max(0.0);
-            let shade = |base: f32| ((0.15 + 0.85 * lambert) * base) as u8;
-            Rgb888::new(shade(235.0), shade(215.0), shade(190.0))
-        })
-        .collect();
-    Scene {
-        objects: vec![Object {
-            positions,
-            indices: indices.to_vec(),
-            colors: ObjectColors::PerTriangle(colors),
-            bounds,
-            mvp: proj * view,
-        }],
-        clip_tris: Vec::new(),
-    }
-}
-
-/// Raw clip-space triangles (white where no colour is given).
-pub fn clip_tris_scene(tris: Vec<ClipTri>) -> Scene {
-    Scene {
-        objects: Vec::new(),
-        clip_tris: tris,
-    }
-}
 
 /// Which depth buffer to render with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -220,8 +76,48 @@ impl DepthImage {
     }
 }
 
+/// The core's counters as printed by `render --stats` and `bench` (the
+/// core's [`Stats`] has no serde; this is its serialisable copy).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Counters {
+    /// Triangles submitted.
+    pub submitted: u64,
+    /// Skipped with their whole object by the bounding-sphere test.
+    pub culled_object: u64,
+    /// Outside the frustum.
+    pub culled_frustum: u64,
+    /// Culled by winding.
+    pub culled_backface: u64,
+    /// Zero area, or no pixel centre covered.
+    pub culled_degenerate: u64,
+    /// Dropped for a non-finite vertex.
+    pub rejected_nonfinite: u64,
+    /// Dropped for a vertex index out of range.
+    pub rejected_index: u64,
+    /// Clipped against the near, far or guard-band planes.
+    pub clipped: u64,
+    /// Set up and stored for drawing.
+    pub stored: u64,
+}
+
+impl From<&Stats> for Counters {
+    fn from(s: &Stats) -> Counters {
+        Counters {
+            submitted: s.submitted,
+            culled_object: s.culled_object,
+            culled_frustum: s.culled_frustum,
+            culled_backface: s.culled_backface,
+            culled_degenerate: s.culled_degenerate,
+            rejected_nonfinite: s.rejected_nonfinite,
+            rejected_index: s.rejected_index,
+            clipped: s.clipped,
+            stored: s.stored,
+        }
+    }
+}
+
 /// Wall-clock times of the stages, in milliseconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Timings {
     /// Transform, cull, clip and setup of every triangle.
     pub setup_ms: f64,
@@ -337,12 +233,12 @@ fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
     let len = color.len();
     let (depth, px) = match kind {
         DepthKind::U16 => {
-            let mut d = vec![u16::CLEAR; len];
+            let mut d = vec![u16::MAX; len];
             let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
             (DepthImage::U16(d), px)
         }
         DepthKind::U32 => {
-            let mut d = vec![u32::CLEAR; len];
+            let mut d = vec![u32::MAX; len];
             let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
             (DepthImage::U32(d), px)
         }
@@ -357,6 +253,7 @@ fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::{cubes_scene, View};
 
     fn opts(threads: usize, strip_rows: u32, depth: DepthKind) -> RenderOptions {
         RenderOptions {
@@ -373,7 +270,7 @@ mod tests {
 
     #[test]
     fn cubes_identical_for_any_threads_and_strips() {
-        let scene = cubes_scene(160, 120);
+        let scene = cubes_scene(&View::new(160, 120)).unwrap();
         for depth in [DepthKind::U16, DepthKind::U32, DepthKind::None] {
             let base = render(&scene, &opts(1, 120, depth)).unwrap();
             assert!(base.pixels_written > 1000);
@@ -389,7 +286,8 @@ mod tests {
 
     #[test]
     fn cubes_draws_every_cube_and_culls_back_faces() {
-        let r = render(&cubes_scene(160, 120), &opts(2, 16, DepthKind::U32)).unwrap();
+        let scene = cubes_scene(&View::new(160, 120)).unwrap();
+        let r = render(&scene, &opts(2, 16, DepthKind::U32)).unwrap();
         let ids = r.ids.unwrap();
         for cube in 0..4u32 {
             assert!(

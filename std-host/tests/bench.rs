@@ -78,7 +78,10 @@ fn sphere_two_frames_prints_valid_json() {
 
 #[test]
 fn thread_list_peers_and_floor() {
-    let v = bench_json(&[
+    // The peers only with the `peers` feature (tests/cli.rs checks the
+    // error without it).
+    let peers = cfg!(feature = "peers");
+    let mut args = vec![
         "--scene",
         "cubes",
         "--size",
@@ -89,24 +92,31 @@ fn thread_list_peers_and_floor() {
         "0",
         "--threads",
         "1,2",
-        "--peers",
         "--floor",
         "--no-split",
         "--compact",
-    ]);
+    ];
+    if peers {
+        args.push("--peers");
+    }
+    let v = bench_json(&args);
     assert!(v.get("split").is_none());
     let s = &v["scaling"];
     assert_eq!(s["identical_output"], true);
     assert_eq!(s["1"]["speedup"], 1.0);
     positive(&s["2"], "speedup");
     assert_eq!(s["1"]["checksum"], v["checksum"]);
-    let p = &v["peers"];
-    positive(p, "euc_over_microraster");
-    positive(&p["embedded_graphics_2d"], "eg_over_microraster");
-    assert_eq!(
-        p["euc"]["covered_pixels"], p["microraster"]["covered_pixels"],
-        "euc and microraster cover the same pixels of the cubes"
-    );
+    if peers {
+        let p = &v["peers"];
+        positive(p, "euc_over_microraster");
+        positive(&p["embedded_graphics_2d"], "eg_over_microraster");
+        assert_eq!(
+            p["euc"]["covered_pixels"], p["microraster"]["covered_pixels"],
+            "euc and microraster cover the same pixels of the cubes"
+        );
+    } else {
+        assert!(v.get("peers").is_none());
+    }
     let f = &v["floor"];
     positive(f, "floor_ms");
     positive(f, "frame_over_floor");
@@ -144,7 +154,8 @@ fn bench_checksum_matches_render() {
         "0",
         "--no-split",
     ]);
-    let out = std::env::temp_dir().join(format!("microraster-bench-{}.png", std::process::id()));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bench.png");
     let o = run(&[
         "render",
         "--scene",
@@ -156,7 +167,6 @@ fn bench_checksum_matches_render() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_file(&out);
     assert_eq!(
         v["checksum"].as_str(),
         Some(String::from_utf8_lossy(&o.stdout).trim())
@@ -165,7 +175,8 @@ fn bench_checksum_matches_render() {
 
 #[test]
 fn render_knows_the_bench_scenes() {
-    let out = std::env::temp_dir().join(format!("microraster-sphere-{}.png", std::process::id()));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sphere.png");
     let o = run(&[
         "render",
         "--scene",
@@ -179,7 +190,6 @@ fn render_knows_the_bench_scenes() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_file(&out);
     let v: Value = serde_json::from_slice(&o.stdout).expect("stats JSON");
     assert_eq!(v["counters"]["submitted"], 20_000);
 }

@@ -1,17 +1,66 @@
 //! End-to-end tests of the `microraster` binary: outputs, invariance over
-//! threads and strips, and one-line errors for bad input.
+//! threads and strips, one-line errors for bad input, and "the CLI never
+//! lies": every option either acts or is refused, every empty or lossy
+//! render says so, and outputs are written all or nothing. Each test makes
+//! its own temporary directory; fixtures are in `tests/data/` or written
+//! here.
 
-use std::path::PathBuf;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::OnceLock;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_microraster"))
 }
 
+/// A directory shared by the tests that only need scratch files, removed
+/// when the process ends (tests that check a directory's contents make
+/// their own).
+fn scratch() -> &'static Path {
+    static DIR: OnceLock<tempfile::TempDir> = OnceLock::new();
+    DIR.get_or_init(|| tempfile::tempdir().unwrap()).path()
+}
+
 fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("microraster-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    scratch().join(name)
+}
+
+fn data(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+const TEAPOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/teapot.obj");
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn ok(args: &[&str]) -> Output {
+    let o = run(args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
+fn fails(args: &[&str]) -> String {
+    let o = run(args);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.starts_with("microraster: error: "), "{args:?}: {e}");
+    assert_eq!(e.trim().lines().count(), 1, "{args:?}: {e}");
+    e
+}
+
+fn stats(args: &[&str]) -> (Value, String) {
+    let out = tmp(&format!(
+        "stats-{}.png",
+        args.join("_").replace(['/', '.', ','], "-")
+    ));
+    let mut a = vec!["render", "--stats", "--out", out.to_str().unwrap()];
+    a.extend_from_slice(args);
+    let o = ok(&a);
+    let v: Value = serde_json::from_slice(&o.stdout).expect("one JSON document");
+    (v, stderr(&o))
 }
 
 fn run(args: &[&str]) -> Output {
@@ -23,7 +72,10 @@ fn stdout(o: &Output) -> String {
 }
 
 fn checksum(extra: &[&str]) -> String {
-    let out = tmp("sum.png");
+    let out = tmp(&format!(
+        "sum-{}.png",
+        extra.join("_").replace(['/', '.', ','], "-")
+    ));
     let mut args = vec!["render", "--checksum", "--out", out.to_str().unwrap()];
     args.extend_from_slice(extra);
     let o = run(&args);
@@ -164,4 +216,404 @@ fn nonfinite_clip_tris_are_counted_not_fatal() {
         "{}",
         stdout(&o)
     );
+}
+
+// ---------------------------------------------------------------------------
+// 1. No silent camera options.
+
+#[test]
+fn fov_and_eye_move_the_cubes_camera() {
+    let plain = checksum(&[]);
+    let fov = checksum(&["--fov", "10"]);
+    let eye = checksum(&["--eye", "0.5,0.5,3", "--target", "0,0,0"]);
+    let eye_only = checksum(&["--eye", "0.5,0.5,3"]);
+    assert_ne!(plain, fov, "--fov 10 was ignored");
+    assert_ne!(plain, eye, "--eye/--target were ignored");
+    assert_ne!(eye, fov);
+    assert_eq!(eye, eye_only, "the cubes' target is the origin");
+    // The defaults are the scene's own camera, spelled out.
+    let spelled = checksum(&["--eye", "0,3.75,6.5", "--target", "0,0,0", "--fov", "60"]);
+    assert_eq!(plain, spelled);
+}
+
+#[test]
+fn fov_alone_moves_the_sphere_and_bunny_cameras() {
+    for scene in ["sphere", "bunny"] {
+        let base = ["--scene", scene, "--size", "64x48"];
+        let plain = checksum(&base);
+        let mut narrow = base.to_vec();
+        narrow.extend(["--fov", "10"]);
+        assert_ne!(plain, checksum(&narrow), "{scene}: --fov ignored");
+    }
+}
+
+#[test]
+fn camera_options_without_a_camera_are_refused() {
+    for opt in [
+        &["--fov", "10"][..],
+        &["--eye", "0.5,0.5,3", "--target", "0,0,0"],
+        &["--target", "0,0,0"],
+    ] {
+        let mut a = vec!["render", "--scene", "quad", "--out"];
+        let out = tmp("quad.png");
+        a.push(out.to_str().unwrap());
+        a.extend_from_slice(opt);
+        let e = fails(&a);
+        assert!(e.contains("quad") && e.contains("no camera"), "{e}");
+        assert!(!out.exists());
+    }
+    let tris = tmp("one.txt");
+    std::fs::write(&tris, "0 0 0 1  1 0 0 1  0 1 0 1\n").unwrap();
+    let e = fails(&[
+        "render",
+        "--clip-tris",
+        tris.to_str().unwrap(),
+        "--fov",
+        "30",
+    ]);
+    assert!(e.contains("--clip-tris") && e.contains("no camera"), "{e}");
+}
+
+// ---------------------------------------------------------------------------
+// 2. No unexplained black images.
+
+#[test]
+fn straight_down_view_renders_the_teapot() {
+    for eye in ["0,10,0", "0,-10,0"] {
+        let (v, err) = stats(&[
+            "--obj", TEAPOT, "--eye", eye, "--target", "0,0,0", "--cull", "none",
+        ]);
+        let px = v["counters"]["pixels_written"].as_u64().unwrap();
+        assert!(px > 10_000, "eye {eye}: {px} pixels\n{err}");
+        assert!(!err.contains("warning"), "{err}");
+    }
+}
+
+#[test]
+fn eye_equal_to_target_is_an_error() {
+    let e = fails(&[
+        "render",
+        "--eye",
+        "1,2,3",
+        "--target",
+        "1,2,3",
+        "--out",
+        "never.png",
+    ]);
+    assert!(e.contains("distinct"), "{e}");
+    let e = fails(&[
+        "render", "--obj", TEAPOT, "--eye", "0,0,0", "--target", "0,0,0",
+    ]);
+    assert!(e.contains("distinct"), "{e}");
+    let e = fails(&["render", "--scene", "sphere", "--eye", "0,0,-3.2"]);
+    assert!(e.contains("distinct"), "{e}");
+    assert!(!Path::new("never.png").exists());
+}
+
+#[test]
+fn render_with_no_pixel_says_so() {
+    // Looking away from the cubes.
+    let (v, err) = stats(&["--eye", "0,0,20", "--target", "0,0,40"]);
+    assert_eq!(v["counters"]["pixels_written"], 0);
+    assert!(err.contains("warning: the image is empty"), "{err}");
+    assert!(
+        err.contains("48 submitted") && err.contains("outside the view"),
+        "{err}"
+    );
+    // A normal render has no warning.
+    let (_, err) = stats(&[]);
+    assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
+fn obj_with_nan_coordinates_reports_the_dropped_triangles() {
+    let obj = tmp("nan.obj");
+    std::fs::write(
+        &obj,
+        "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nv nan 0 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let (v, err) = stats(&["--obj", obj.to_str().unwrap()]);
+    assert_eq!(v["counters"]["rejected_nonfinite"], 1);
+    assert!(err.contains("warning: 1 of 2 triangles dropped"), "{err}");
+}
+
+#[test]
+fn obj_with_huge_coordinates_is_not_silent() {
+    // 1e19 squared overflows f32: whatever the core makes of it (dropped,
+    // or culled), the render must not pass for a normal one.
+    let obj = tmp("huge.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e19 0 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let (v, err) = stats(&["--obj", obj.to_str().unwrap(), "--cull", "none"]);
+    let c = &v["counters"];
+    let drew = c["pixels_written"].as_u64().unwrap() > 0;
+    let dropped = c["rejected_nonfinite"].as_u64().unwrap() > 0;
+    assert!(drew || err.contains("warning"), "{v}\n{err}");
+    assert_eq!(dropped, err.contains("dropped"), "{v}\n{err}");
+}
+
+#[test]
+fn nonfinite_clip_tris_are_reported() {
+    let file = tmp("nan2.txt");
+    std::fs::write(
+        &file,
+        "nan 0 0 1  1 0 0 1  0 1 0 1\n-1 -1 0 1  1 -1 0 1  0 1 0 1\n",
+    )
+    .unwrap();
+    let (v, err) = stats(&["--clip-tris", file.to_str().unwrap()]);
+    assert_eq!(v["counters"]["rejected_nonfinite"], 1);
+    assert!(err.contains("1 of 2 triangles dropped"), "{err}");
+}
+
+#[test]
+fn empty_clip_tris_file_is_an_error_like_an_empty_obj() {
+    let tris = tmp("empty.txt");
+    std::fs::write(&tris, "# nothing here\n\n").unwrap();
+    let e = fails(&["render", "--clip-tris", tris.to_str().unwrap()]);
+    assert!(e.contains("empty.txt") && e.contains("no triangles"), "{e}");
+    let obj = tmp("empty.obj");
+    std::fs::write(&obj, "").unwrap();
+    let e = fails(&["render", "--obj", obj.to_str().unwrap()]);
+    assert!(e.contains("empty.obj") && e.contains("no triangles"), "{e}");
+}
+
+// ---------------------------------------------------------------------------
+// 3. Nothing is lost or half-written.
+
+#[test]
+fn two_outputs_naming_the_same_file_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let (a, b) = (format!("{d}/a.png"), format!("{d}/b.png"));
+    let a_again = format!("{d}/./sub/../a.png");
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let e = fails(&["render", "--out", &b, "--depth-out", &b]);
+    assert!(e.contains("same file"), "{e}");
+    let e = fails(&["render", "--out", &a, "--id-out", &a_again]);
+    assert!(e.contains("same file") && e.contains("--id-out"), "{e}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "only sub/ may exist: {left:?}");
+}
+
+#[test]
+fn depth_out_without_a_depth_buffer_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = dir.path().join("x.raw");
+    let out = dir.path().join("c.png");
+    let e = fails(&[
+        "render",
+        "--depth",
+        "none",
+        "--depth-out",
+        raw.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(e.contains("--depth-out") && e.contains("none"), "{e}");
+    assert!(!raw.exists() && !out.exists());
+}
+
+#[test]
+fn no_output_is_written_unless_all_can_be() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cubes.png");
+    let e = fails(&[
+        "render",
+        "--out",
+        out.to_str().unwrap(),
+        "--depth-out",
+        dir.path().join("missing/d.raw").to_str().unwrap(),
+    ]);
+    assert!(e.contains("missing"), "{e}");
+    assert!(!out.exists(), "cubes.png was written before the failure");
+    // A directory in the way of an output.
+    std::fs::create_dir(dir.path().join("ids.png")).unwrap();
+    fails(&[
+        "render",
+        "--out",
+        out.to_str().unwrap(),
+        "--id-out",
+        dir.path().join("ids.png").to_str().unwrap(),
+    ]);
+    assert!(!out.exists());
+    // And a successful render leaves no temporary file behind.
+    ok(&[
+        "render",
+        "--size",
+        "32x24",
+        "--out",
+        out.to_str().unwrap(),
+        "--depth-out",
+        dir.path().join("d.raw").to_str().unwrap(),
+    ]);
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["cubes.png", "d.raw", "ids.png"]);
+}
+
+// ---------------------------------------------------------------------------
+// 4. Small things.
+
+#[test]
+fn stats_and_checksum_print_one_json_document() {
+    let (v, err) = stats(&["--checksum", "--size", "64x48"]);
+    let sum = checksum(&["--size", "64x48"]);
+    assert_eq!(v["checksum"].as_str(), Some(sum.as_str()));
+    assert!(
+        v["counters"]["submitted"] == 48 && v["timings"].is_object(),
+        "{v}"
+    );
+    // The "wrote" line stays, on stderr.
+    assert!(
+        err.contains("microraster: wrote ") && err.contains("64x48"),
+        "{err}"
+    );
+}
+
+#[test]
+fn wrote_line_is_on_stderr() {
+    let out = tmp("w.png");
+    let o = ok(&["render", "--size", "16x16", "--out", out.to_str().unwrap()]);
+    assert!(o.stdout.is_empty());
+    assert!(stderr(&o).contains("wrote"), "{}", stderr(&o));
+}
+
+#[test]
+fn negative_fov_gives_the_range_message() {
+    for fov in ["-5", "0", "180", "nan"] {
+        let o = run(&["render", "--fov", fov]);
+        assert_eq!(o.status.code(), Some(2), "{fov}");
+        let e = stderr(&o);
+        assert!(e.contains("between 0 and 180"), "{fov}: {e}");
+    }
+    let o = run(&["bench", "--fov", "-5"]);
+    assert!(stderr(&o).contains("between 0 and 180"), "{}", stderr(&o));
+}
+
+#[test]
+fn obj_errors_name_the_file_and_line() {
+    let obj = tmp("bad-face.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\n# faces\nf 1 2 x\n").unwrap();
+    let e = fails(&["render", "--obj", obj.to_str().unwrap()]);
+    assert!(
+        e.contains("bad-face.obj: line 5:") && e.contains("`f 1 2 x`"),
+        "{e}"
+    );
+    let obj = tmp("bad-vertex.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 O 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let e = fails(&["render", "--obj", obj.to_str().unwrap()]);
+    assert!(
+        e.contains("bad-vertex.obj: line 2:") && e.contains("three numbers"),
+        "{e}"
+    );
+    let obj = tmp("bad-index.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
+    let e = fails(&["render", "--obj", obj.to_str().unwrap()]);
+    assert!(e.contains("line 4:") && e.contains("index 7"), "{e}");
+}
+
+#[test]
+fn the_fixture_obj_renders() {
+    let (v, err) = stats(&["--obj", &data("two-triangles.obj"), "--size", "40x30"]);
+    assert_eq!(v["counters"]["submitted"], 2);
+    assert!(
+        v["counters"]["pixels_written"].as_u64().unwrap() > 100,
+        "{err}"
+    );
+}
+
+#[test]
+fn bench_without_a_tty_prints_progress_lines() {
+    let o = bin()
+        .args([
+            "bench",
+            "--scene",
+            "cubes",
+            "--size",
+            "32x24",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--no-split",
+            "--compact",
+        ])
+        .env("MICRORASTER_PROGRESS_MS", "0")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains("frame")).collect();
+    assert!(lines.len() >= 3, "{err}");
+    assert!(
+        lines.iter().all(|l| l.starts_with("microraster bench: ")),
+        "{err}"
+    );
+    assert!(
+        !err.contains('\r'),
+        "no terminal, no carriage returns: {err:?}"
+    );
+    let v: Value = serde_json::from_slice(&o.stdout).expect("stdout is only the JSON");
+    assert!(v["median_ms"].as_f64().unwrap() > 0.0);
+    // Short runs print nothing at the default interval.
+    let o = run(&[
+        "bench",
+        "--scene",
+        "cubes",
+        "--size",
+        "32x24",
+        "--frames",
+        "2",
+        "--no-split",
+    ]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
+}
+
+#[test]
+fn render_help_says_which_options_each_scene_uses() {
+    let o = ok(&["render", "--help"]);
+    let h = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "Which options each source uses",
+        "--scene cubes",
+        "--scene sphere",
+        "--scene quad          no camera",
+        "--clip-tris FILE      no camera",
+        "--obj FILE",
+    ] {
+        assert!(h.contains(want), "{want:?} missing from:\n{h}");
+    }
+}
+
+// ---------------------------------------------------------------------------
+// 6. Peers and report out of the default build.
+
+#[test]
+#[cfg(not(feature = "peers"))]
+fn peers_without_the_feature_is_an_error_naming_it() {
+    let e = fails(&[
+        "bench", "--scene", "quad", "--size", "8x8", "--frames", "1", "--peers",
+    ]);
+    assert!(e.contains("--features peers"), "{e}");
+    // bench itself works.
+    ok(&[
+        "bench", "--scene", "quad", "--size", "8x8", "--frames", "1", "--warmup", "0",
+    ]);
+}
+
+#[test]
+#[cfg(not(feature = "report"))]
+fn report_without_the_feature_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let e = fails(&["report", "speed-vs-error", out.to_str().unwrap(), "--quick"]);
+    assert!(e.contains("--features report"), "{e}");
+    assert!(!out.exists());
 }

@@ -128,7 +128,11 @@ impl Renderer {
         let mut drawer = StripDrawer::new(&mut self.color, &mut self.depth[..], Rgb565::BLACK);
         let drawn = drawer.draw(display, Config::new(WIDTH, HEIGHT), |strip| {
             for (i, mvp) in mvps.iter().enumerate() {
-                strip.submit_mesh(&cubes::MESH, mvp, (i * cubes::CUBE_INDICES.len()) as u32);
+                // A strip renderer stores nothing, so it cannot fill up.
+                let id = (i * cubes::CUBE_INDICES.len()) as u32;
+                strip
+                    .submit_mesh(&cubes::MESH, mvp, id)
+                    .expect("twelve triangles");
             }
         });
         // The simulator's display cannot fail, and the buffers fit.

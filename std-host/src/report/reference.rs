@@ -2,7 +2,7 @@
 //! geometry.
 //!
 //! Design note: this is the yardstick of the speed-vs-error report
-//! ([`crate::report`]). It takes clip-space triangles in `f64` (no `f32`
+//! ([`super`], the speed-vs-error report). It takes clip-space triangles in `f64` (no `f32`
 //! vertex stage, no snapping) and follows the core's conventions: OpenGL
 //! clip space, window row 0 at the top, pixel centres at `+0.5`,
 //! counter-clockwise front faces in NDC, depth test `Less` against a buffer

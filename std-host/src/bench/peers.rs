@@ -18,9 +18,18 @@
 //!   microraster draws the same integer triangles (vertices at the pixel
 //!   centres, as clip-space triangles: [`tris_2d_scene`]) without depth
 //!   into RGB565.
+//!
+//! [`peers_section`] times them against microraster on one thread. The
+//! module is compiled only with the `peers` feature, so the default build
+//! links neither peer.
 
+use super::runs::{BenchColor, Run};
+use super::stats::{ms, time_frames, Summary};
+use super::Settings;
+use crate::bench_scenes::BenchScene;
 use crate::cliptris::ClipTri;
-use crate::render::{Object, ObjectColors, Scene};
+use crate::pipeline::FramePipeline;
+use crate::scene::{Object, ObjectColors, Scene};
 use embedded_graphics::pixelcolor::{Rgb565, Rgb888, RgbColor};
 use embedded_graphics::prelude::{
     DrawTarget, OriginDimensions, Point, PointsIter, Primitive, Size,
@@ -30,8 +39,11 @@ use embedded_graphics::Drawable;
 use euc::buffer::Buffer2d;
 use euc::rasterizer::{BackfaceCullingDisabled, BackfaceCullingEnabled, Triangles};
 use euc::{Pipeline, Target};
+use microraster::Config;
 use microraster::{CullMode, Mat4, Vec3, Vec4};
+use serde_json::{json, Value};
 use std::convert::Infallible;
+use std::time::Instant;
 
 /// The euc version benchmarked (as in `std-host/Cargo.toml`).
 pub const EUC_VERSION: &str = "0.5";
@@ -274,7 +286,7 @@ pub fn tris_2d_scene(tris: &[Tri2d], width: u32, height: u32) -> Scene {
             }
         })
         .collect();
-    crate::render::clip_tris_scene(clip_tris)
+    crate::scene::clip_tris_scene(clip_tris)
 }
 
 /// Draws `tris` with embedded-graphics' filled `Triangle`.
@@ -379,11 +391,87 @@ impl DrawTarget for Framebuffer {
     }
 }
 
+/// euc and embedded-graphics against microraster, one thread.
+pub fn peers_section<const S: u32, C: BenchColor>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    mr: &Run,
+) -> Result<Value, String> {
+    let mr_sum = Summary::of(&mr.total);
+    let mut mr_json = mr_sum.json();
+    mr_json["covered_pixels"] = json!(mr.covered);
+    let mut o = json!({ "threads": 1, "microraster": mr_json });
+
+    // euc: same scene, same frames.
+    if bs.scene.objects.is_empty() {
+        o["euc"] = json!("skipped: the scene has no meshes");
+    } else if s.cull == CullMode::Front {
+        o["euc"] = json!("skipped: euc cannot cull front faces");
+    } else {
+        let mut e = EucScene::<C::Packed>::new(&bs.scene, s.width, s.height, s.cull)?;
+        let mut times = Vec::new();
+        for k in 0..s.warmup + s.frames {
+            bs.set_frame(k);
+            let t = Instant::now();
+            e.draw(&bs.scene);
+            if k >= s.warmup {
+                times.push(ms(t));
+            }
+        }
+        let sum = Summary::of(&times);
+        let mut ej = sum.json();
+        ej["version"] = json!(EUC_VERSION);
+        ej["depth"] = json!("f32");
+        ej["covered_pixels"] = json!(e.covered());
+        o["euc"] = ej;
+        o["euc_over_microraster"] = json!(sum.median / mr_sum.median);
+        o["euc_over_microraster_min"] = json!(sum.min / mr_sum.min);
+    }
+
+    // embedded-graphics: the same 2D triangles, flat, no depth, RGB565.
+    bs.set_frame(0);
+    let tris = project_2d(&bs.scene, s.width, s.height, s.cull);
+    let mut fb = Framebuffer::new(s.width, s.height);
+    let eg = time_frames(s.warmup, s.frames, |_| {
+        use embedded_graphics::prelude::DrawTarget;
+        let _ = fb.clear(Rgb565::BLACK);
+        let _ = draw_eg(&mut fb, &tris);
+        Ok(())
+    })?;
+    let flat = tris_2d_scene(&tris, s.width, s.height);
+    let mut config = Config::new(s.width, s.height);
+    config.cull = CullMode::None;
+    let len = s.width as usize * s.height as usize;
+    let mut color = vec![Rgb565::BLACK; len];
+    let mut pipe = FramePipeline::<S>::new(config, 1, s.strip_rows);
+    let ours = time_frames(s.warmup, s.frames, |_| {
+        pipe.render::<Rgb565, u32>(&flat, &mut color, None, Rgb565::BLACK)?;
+        Ok(())
+    })?;
+    let (eg_sum, ours_sum) = (Summary::of(&eg), Summary::of(&ours));
+    let mut gm = ours_sum.json();
+    gm["covered_pixels"] = json!(color.iter().filter(|&&c| c != Rgb565::BLACK).count());
+    let mut ge = eg_sum.json();
+    ge["covered_pixels"] = json!(fb.covered());
+    o["embedded_graphics_2d"] = json!({
+        "triangles": tris.len(),
+        "microraster": gm,
+        "embedded_graphics": ge,
+        "eg_over_microraster": eg_sum.median / ours_sum.median,
+        "method": "the scene's visible triangles (frame 0) projected and rounded to pixel \
+             centres outside the clock; flat colour, RGB565, no depth, no culling; both clear \
+             a whole-frame buffer and draw every triangle each frame (microraster: setup, \
+             binning and drawing of the same triangles as clip-space input).",
+    });
+    Ok(o)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench_scenes::{sphere_scene, View};
+    use crate::bench_scenes::sphere_scene;
     use crate::render::{DepthKind, RenderOptions};
+    use crate::scene::View;
 
     fn opts(width: u32, height: u32, depth: DepthKind) -> RenderOptions {
         RenderOptions {
@@ -400,7 +488,7 @@ mod tests {
 
     #[test]
     fn euc_draws_the_sphere_like_microraster() {
-        let (scene, _) = sphere_scene(&View::new(120, 160), 24, 24);
+        let (scene, _) = sphere_scene(&View::new(120, 160), 24, 24).unwrap();
         let mut e = EucScene::<u16>::new(&scene, 120, 160, CullMode::Back).unwrap();
         e.draw(&scene);
         let mr = crate::render::render(&scene, &opts(120, 160, DepthKind::U16)).unwrap();
@@ -435,7 +523,7 @@ mod tests {
 
     #[test]
     fn same_2d_triangles_cover_about_the_same_pixels() {
-        let (scene, _) = sphere_scene(&View::new(120, 160), 16, 16);
+        let (scene, _) = sphere_scene(&View::new(120, 160), 16, 16).unwrap();
         let tris = project_2d(&scene, 120, 160, CullMode::Back);
         // More than half the faces point away (or leave the frame).
         assert!(tris.len() > 100 && tris.len() < 256, "{}", tris.len());

@@ -1,0 +1,280 @@
+//! The timed runs of `microraster bench`: one [`FramePipeline`] per thread
+//! count, kept for the whole run.
+//!
+//! Design note: [`bench_with`] is monomorphised once per colour format,
+//! depth format and sub-pixel precision, so the timed loop has no dynamic
+//! dispatch. Each run reuses its pipeline (vertex caches, setup storage,
+//! bins) and its colour and depth buffers from frame to frame; spinning
+//! scenes get frame `k`'s matrix before the frame's clock starts. The
+//! sections after the runs (split, floor, peers) take the same scene as in
+//! frame 0. Progress goes to [`Progress`], never to stdout.
+
+use super::progress::Progress;
+use super::sections::{floor, split};
+use super::stats::{median, ms, Summary};
+use super::Settings;
+use crate::bench_scenes::BenchScene;
+use crate::cli::DepthArg;
+use crate::pipeline::FramePipeline;
+use crate::render::{self, fnv1a64, DepthKind, RenderOptions, BACKGROUND};
+use microraster::pixelcolor::{Rgb565, Rgb888, RgbColor};
+use microraster::DepthWord;
+use microraster::{Config, PixelFormat, Stats};
+use serde_json::{json, Value};
+use std::time::Instant;
+
+/// A colour format the benchmark draws into.
+pub trait BenchColor: PixelFormat + Send + Sync + PartialEq + 'static {
+    /// The background.
+    const CLEAR: Self;
+    /// The same format packed for euc.
+    #[cfg(feature = "peers")]
+    type Packed: super::peers::PackedPixel;
+    /// As RGB8.
+    fn rgb888(self) -> Rgb888;
+}
+
+impl BenchColor for Rgb888 {
+    const CLEAR: Self = BACKGROUND;
+    #[cfg(feature = "peers")]
+    type Packed = u32;
+    fn rgb888(self) -> Rgb888 {
+        self
+    }
+}
+
+impl BenchColor for Rgb565 {
+    const CLEAR: Self = Rgb565::BLACK;
+    #[cfg(feature = "peers")]
+    type Packed = u16;
+    fn rgb888(self) -> Rgb888 {
+        Rgb888::from(self)
+    }
+}
+
+/// The core configuration of `s`.
+pub fn config_of(s: &Settings) -> Config {
+    let mut c = Config::new(s.width, s.height);
+    c.cull = s.cull;
+    c
+}
+
+/// One run of `frames` frames at one thread count.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// Worker threads.
+    pub threads: usize,
+    /// Whole-frame milliseconds, one per timed frame.
+    pub total: Vec<f64>,
+    /// Setup (vertex + triangles + binning) milliseconds.
+    pub setup: Vec<f64>,
+    /// Vertex stage milliseconds.
+    pub vertex: Vec<f64>,
+    /// Triangle stage milliseconds.
+    pub triangles: Vec<f64>,
+    /// Binning milliseconds.
+    pub binning: Vec<f64>,
+    /// Clear and draw milliseconds.
+    pub raster: Vec<f64>,
+    /// Pixels written in the last frame.
+    pub pixels_written: u64,
+    /// The core's counters of the last frame.
+    pub stats: Stats,
+    /// FNV-1a of the last frame's RGB8 bytes.
+    pub checksum: u64,
+    /// Pixels that differ from the background in the last frame.
+    pub covered: u64,
+    /// The last frame as RGB8, if asked for.
+    pub image: Option<Vec<u8>>,
+}
+
+/// Everything one format's runs measured.
+#[derive(Debug)]
+pub struct Formats {
+    /// One run per thread count.
+    pub runs: Vec<Run>,
+    /// The `render_fn` section.
+    pub render_fn: Option<Value>,
+    /// The `split` section.
+    pub split: Option<Value>,
+    /// The `floor` section.
+    pub floor: Option<Value>,
+    /// The `peers` section.
+    pub peers: Option<Value>,
+    /// The first run's last frame as RGB8.
+    pub image: Option<Vec<u8>>,
+}
+
+/// All runs and sections of `s` in one colour, depth and sub-pixel format.
+pub fn bench_with<const S: u32, C: BenchColor, T: DepthWord>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    depth_on: bool,
+    progress: &mut Progress,
+) -> Result<Formats, String> {
+    let mut runs = Vec::new();
+    let n = s.threads.len();
+    for (i, &threads) in s.threads.iter().enumerate() {
+        let what = format!("run {}/{n} ({threads} threads)", i + 1);
+        let run = run_frames::<S, C, T>(bs, s, depth_on, threads, i == 0, &what, progress)?;
+        runs.push(run);
+    }
+    let image = runs.first_mut().and_then(|r| r.image.take());
+    let render_fn = if s.render_fn {
+        Some(render_fn_section(bs, s, runs[0].threads, progress)?)
+    } else {
+        None
+    };
+    bs.set_frame(0);
+    let split = if s.split && !bs.scene.objects.is_empty() {
+        progress.note("stage split");
+        Some(split::<S, C, T>(&bs.scene, s, depth_on)?)
+    } else {
+        None
+    };
+    let floor = if s.floor {
+        progress.note("memory floor");
+        Some(floor::<S, C, T>(&bs.scene, s, depth_on, &runs[0])?)
+    } else {
+        None
+    };
+    // Without the feature, `--peers` was refused before any run.
+    #[cfg(feature = "peers")]
+    let peers = if s.peers {
+        peers_of::<S, C, T>(bs, s, depth_on, &runs, progress)?
+    } else {
+        None
+    };
+    #[cfg(not(feature = "peers"))]
+    let peers = None;
+    Ok(Formats {
+        runs,
+        render_fn,
+        split,
+        floor,
+        peers,
+        image,
+    })
+}
+
+/// The peers section, with microraster's one-thread run beside it.
+#[cfg(feature = "peers")]
+fn peers_of<const S: u32, C: BenchColor, T: DepthWord>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    depth_on: bool,
+    runs: &[Run],
+    progress: &mut Progress,
+) -> Result<Option<Value>, String> {
+    let mr = match runs.iter().find(|r| r.threads == 1) {
+        Some(r) => r.clone(),
+        None => run_frames::<S, C, T>(bs, s, depth_on, 1, false, "peers: 1 thread", progress)?,
+    };
+    progress.note("peers");
+    Ok(Some(super::peers::peers_section::<S, C>(bs, s, &mr)?))
+}
+
+/// Times `s.warmup + s.frames` frames at `threads` threads.
+#[allow(clippy::too_many_arguments)]
+pub fn run_frames<const S: u32, C: BenchColor, T: DepthWord>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    depth_on: bool,
+    threads: usize,
+    keep_image: bool,
+    what: &str,
+    progress: &mut Progress,
+) -> Result<Run, String> {
+    let mut pipe = FramePipeline::<S>::new(config_of(s), threads, s.strip_rows);
+    let len = s.width as usize * s.height as usize;
+    let mut color = vec![C::CLEAR; len];
+    let mut depth = vec![T::FAR; if depth_on { len } else { 0 }];
+    let mut run = Run {
+        threads,
+        total: Vec::new(),
+        setup: Vec::new(),
+        vertex: Vec::new(),
+        triangles: Vec::new(),
+        binning: Vec::new(),
+        raster: Vec::new(),
+        pixels_written: 0,
+        stats: Stats::default(),
+        checksum: 0,
+        covered: 0,
+        image: None,
+    };
+    for k in 0..s.warmup + s.frames {
+        progress.tick(what, k, s.warmup + s.frames);
+        bs.set_frame(k);
+        let t0 = Instant::now();
+        let d = depth_on.then_some(&mut depth[..]);
+        let (setup, raster_ms, px) = pipe.render(&bs.scene, &mut color, d, C::CLEAR)?;
+        let frame_ms = ms(t0);
+        if k >= s.warmup {
+            run.total.push(frame_ms);
+            run.setup.push(setup.total_ms());
+            run.vertex.push(setup.vertex_ms);
+            run.triangles.push(setup.triangles_ms);
+            run.binning.push(setup.binning_ms);
+            run.raster.push(raster_ms);
+        }
+        (run.pixels_written, run.stats) = (px, setup.stats);
+    }
+    let rgb: Vec<u8> = color
+        .iter()
+        .flat_map(|c| {
+            let c = c.rgb888();
+            [c.r(), c.g(), c.b()]
+        })
+        .collect();
+    run.checksum = fnv1a64(&rgb);
+    run.covered = color.iter().filter(|&&c| c != C::CLEAR).count() as u64;
+    run.image = keep_image.then_some(rgb);
+    Ok(run)
+}
+
+/// `render::render` itself, frame by frame (allocations, RGB8 output and
+/// all), as a cross-check of the pipeline above.
+fn render_fn_section(
+    bs: &mut BenchScene,
+    s: &Settings,
+    threads: usize,
+    progress: &mut Progress,
+) -> Result<Value, String> {
+    let opts = RenderOptions {
+        width: s.width,
+        height: s.height,
+        cull: s.cull,
+        depth: match s.depth {
+            DepthArg::U16 => DepthKind::U16,
+            DepthArg::U32 => DepthKind::U32,
+            DepthArg::None => DepthKind::None,
+        },
+        subpixel: s.subpixel,
+        threads,
+        strip_rows: s.strip_rows,
+        ids: false,
+    };
+    let (mut total, mut setup, mut raster) = (Vec::new(), Vec::new(), Vec::new());
+    let mut checksum = 0;
+    for k in 0..s.warmup + s.frames {
+        progress.tick("render_fn", k, s.warmup + s.frames);
+        bs.set_frame(k);
+        let t = Instant::now();
+        let r = render::render(&bs.scene, &opts)?;
+        let frame_ms = ms(t);
+        if k >= s.warmup {
+            total.push(frame_ms);
+            setup.push(r.timings.setup_ms);
+            raster.push(r.timings.raster_ms);
+        }
+        checksum = r.checksum();
+    }
+    let mut o = Summary::of(&total).json();
+    o["threads"] = json!(threads);
+    o["setup_median_ms"] = json!(median(&setup));
+    o["raster_median_ms"] = json!(median(&raster));
+    o["color"] = json!("rgb888");
+    o["checksum"] = json!(format!("{checksum:016x}"));
+    Ok(o)
+}

@@ -1,0 +1,503 @@
+//! `microraster report speed-vs-error OUT_DIR`: what each configuration
+//! costs in time and in accuracy.
+//!
+//! Design note: the report sweeps the eight compile-time configurations of
+//! the core (subpixel bits 4 / 8, depth `u16` / `u32`, matrices built with
+//! `libm` / `micromath`) over four scenes (the four cubes, Spot, the teapot
+//! and the Stanford bunny from `assets/models/`), every one with per-vertex
+//! colours from its normals so that Gouraud interpolation is exercised.
+//!
+//! For each configuration and scene it measures
+//! - the frame time: median of repeated single-threaded frames, each one
+//!   building the matrices with the configuration's float backend, setting
+//!   up every triangle into a [`Frame`] and rendering all rows into an
+//!   `Rgb888` buffer and a depth buffer (buffers allocated beforehand);
+//! - the error against [`reference`](mod@reference), which renders the same scene
+//!   from `f64` vertices and `f64` matrices with no snapping:
+//!   pixels whose triangle id differs, those among them where only coverage
+//!   differs (background in one, a triangle in the other), the depth error
+//!   in LSB of the buffer at pixels drawn by the same triangle in both
+//!   (against `floor(z * 2^bits)` of the exact depth), and the colour error
+//!   per channel (against the exact colour rounded to nearest);
+//! - the error the `f32` vertex stage brings in before snapping: the largest
+//!   matrix-entry error (relative to the matrix's largest entry) and the
+//!   largest window-space vertex error (pixels, and window depth), both
+//!   against `f64`. For `micromath` this is what its approximations cost.
+//!
+//! Every difference is also checked against what snapping and the measured
+//! vertex error explain: a pixel whose triangle differs must lie within the
+//! snapping tolerance (half a subpixel per axis plus the vertex error) of an
+//! edge of one of the two triangles, or be a depth tie within the depth
+//! tolerance; a depth or colour error must be within the error that moving
+//! the vertices by that tolerance causes, plus the documented 1 LSB of
+//! interpolation and 1 LSB of rounding. Whatever is left is counted as
+//! "unexplained" and would be a bug in the core.
+//!
+//! Output: `OUT_DIR/speed-vs-error.md` (tables) and
+//! `OUT_DIR/speed-vs-error.png` (time against error, one point per
+//! configuration, the Pareto front marked), drawn with `plotters`; text in
+//! the plot is drawn with embedded-graphics' built-in mono font, so no
+//! system font is needed.
+//!
+//! The code is split by concern: [`scenes`] (the scenes and their matrices),
+//! `core_run` (the timed core frames), [`reference`](mod@reference) (the `f64` renderer),
+//! `compare` (errors and what explains them), `markdown` and `plot` (the
+//! output). The whole module is built only with the `report` feature.
+
+use crate::cli::{ReportArgs, REPORT_SCENES};
+use crate::cubes;
+use crate::obj;
+use microraster::math::{radians, FloatFns, Libm, Micromath};
+use microraster::pixelcolor::{Rgb888, RgbColor};
+use microraster::{
+    BoundingSphere, Config, CullMode, DepthBuffer, Error, Frame, FrontFace, Mat4, Mesh, MeshColors,
+    SetupTriangle, TriangleId, Vec3,
+};
+use reference::{mat, Prepared, RefImage, RefOptions, RefTriangle, RefVertex};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+mod compare;
+mod core_run;
+mod markdown;
+mod plot;
+pub mod reference;
+pub mod scenes;
+
+pub use compare::*;
+pub(crate) use core_run::*;
+pub use markdown::*;
+pub use scenes::*;
+
+/// Writes the report.
+pub fn run(args: &ReportArgs) -> Result<(), String> {
+    match args.which.as_str() {
+        "speed-vs-error" => speed_vs_error(args),
+        other => Err(format!("unknown report {other:?} (known: speed-vs-error)")),
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Configurations
+
+/// The float backend the matrices are built with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MathBackend {
+    /// `libm`: accurate.
+    Libm,
+    /// `micromath`: fast approximations.
+    Micromath,
+}
+
+impl MathBackend {
+    /// The cargo feature's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MathBackend::Libm => "libm",
+            MathBackend::Micromath => "micromath",
+        }
+    }
+}
+
+/// One compile-time configuration of the core.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Configuration {
+    /// Subpixel bits: 4 or 8.
+    pub subpixel: u32,
+    /// Depth buffer bits: 16 or 32.
+    pub depth_bits: u32,
+    /// Float backend of the matrices.
+    pub math: MathBackend,
+}
+
+impl Configuration {
+    /// A short name, e.g. `S8 u16 libm`.
+    pub fn label(&self) -> String {
+        format!(
+            "S{} u{} {}",
+            self.subpixel,
+            self.depth_bits,
+            self.math.name()
+        )
+    }
+}
+
+/// Every configuration the report compares.
+pub const CONFIGURATIONS: [Configuration; 8] = {
+    let mut out = [Configuration {
+        subpixel: 8,
+        depth_bits: 16,
+        math: MathBackend::Libm,
+    }; 8];
+    let mut i = 0;
+    while i < 8 {
+        out[i] = Configuration {
+            subpixel: if i & 4 == 0 { 4 } else { 8 },
+            depth_bits: if i & 2 == 0 { 16 } else { 32 },
+            math: if i & 1 == 0 {
+                MathBackend::Libm
+            } else {
+                MathBackend::Micromath
+            },
+        };
+        i += 1;
+    }
+    out
+};
+
+// ---------------------------------------------------------------------------
+// The report
+
+/// One configuration on one scene.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Scene name.
+    pub scene: String,
+    /// Configuration.
+    pub config: Configuration,
+    /// Median frame time, milliseconds.
+    pub time_ms: f64,
+    /// Errors against the reference.
+    pub errors: ErrorStats,
+    /// Vertex-stage error.
+    pub vertex: VertexError,
+}
+
+/// One configuration over every scene.
+#[derive(Clone, Debug)]
+pub struct Summary {
+    /// Configuration.
+    pub config: Configuration,
+    /// Sum of the scenes' median frame times, milliseconds.
+    pub time_ms: f64,
+    /// Pixels whose triangle differs, percent of the reference's covered
+    /// pixels (all scenes together).
+    pub id_diff_pct: f64,
+    /// Coverage-only differences, percent of covered pixels.
+    pub coverage_diff_pct: f64,
+    /// Unexplained differences (all scenes).
+    pub unexplained: usize,
+    /// Largest depth error, LSB.
+    pub depth_max_lsb: f64,
+    /// Mean `|stored / 2^bits - exact|` depth, window-depth units.
+    pub depth_mean_abs: f64,
+    /// Largest of the same.
+    pub depth_max_abs: f64,
+    /// Depth errors beyond the explained bound.
+    pub depth_beyond: usize,
+    /// Largest colour error, LSB.
+    pub color_max: f64,
+    /// Colour errors beyond the explained bound.
+    pub color_beyond: usize,
+    /// Largest relative matrix error.
+    pub matrix_rel: f64,
+    /// Largest vertex error, pixels.
+    pub vertex_px: f64,
+}
+
+/// Sums rows into one summary per configuration, in [`CONFIGURATIONS`]
+/// order.
+pub fn summarize(rows: &[Row]) -> Vec<Summary> {
+    let mut out = Vec::new();
+    for c in CONFIGURATIONS {
+        let rs: Vec<&Row> = rows.iter().filter(|r| r.config == c).collect();
+        if rs.is_empty() {
+            continue;
+        }
+        let covered: usize = rs.iter().map(|r| r.errors.covered).sum::<usize>().max(1);
+        let same: usize = rs.iter().map(|r| r.errors.same).sum::<usize>().max(1);
+        let fmax = |f: &dyn Fn(&Row) -> f64| rs.iter().map(|r| f(r)).fold(0.0, f64::max);
+        let sum = |f: &dyn Fn(&Row) -> usize| rs.iter().map(|r| f(r)).sum::<usize>();
+        out.push(Summary {
+            config: c,
+            time_ms: rs.iter().map(|r| r.time_ms).sum(),
+            id_diff_pct: 100.0 * sum(&|r| r.errors.id_diff) as f64 / covered as f64,
+            coverage_diff_pct: 100.0 * sum(&|r| r.errors.coverage_diff) as f64 / covered as f64,
+            unexplained: sum(&|r| r.errors.unexplained),
+            depth_max_lsb: fmax(&|r| r.errors.depth_max_lsb),
+            depth_mean_abs: rs
+                .iter()
+                .map(|r| r.errors.depth_abs_mean * r.errors.same as f64)
+                .sum::<f64>()
+                / same as f64,
+            depth_max_abs: fmax(&|r| r.errors.depth_abs_max),
+            depth_beyond: sum(&|r| r.errors.depth_beyond),
+            color_max: fmax(&|r| r.errors.color_max),
+            color_beyond: sum(&|r| r.errors.color_beyond),
+            matrix_rel: fmax(&|r| r.vertex.matrix_rel),
+            vertex_px: fmax(&|r| r.vertex.window_px),
+        });
+    }
+    out
+}
+
+/// The settings a report ran with.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunInfo {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Timed repetitions.
+    pub reps: u32,
+}
+
+fn default_models_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join("assets")
+        .join("models")
+}
+
+/// Loads the named scene.
+pub fn load_scene(name: &str, models: &Path, aspect: f32) -> Result<SceneSpec, String> {
+    let file = match name {
+        "cubes" => return Ok(cubes_spec()),
+        "spot" => "spot.obj",
+        "teapot" => "teapot.obj",
+        "bunny" => "stanford-bunny.obj",
+        other => return Err(format!("unknown scene {other:?}")),
+    };
+    let mesh = obj::load_obj(&models.join(file))?;
+    Ok(mesh_spec(name, &mesh, aspect))
+}
+
+fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
+    let (width, height) = args
+        .size
+        .unwrap_or(if args.quick { (160, 120) } else { (800, 600) });
+    let reps = args.reps.unwrap_or(if args.quick { 3 } else { 7 });
+    let names: Vec<String> = args
+        .scenes
+        .clone()
+        .unwrap_or_else(|| REPORT_SCENES.iter().map(|s| s.to_string()).collect());
+    let models = args.models.clone().unwrap_or_else(default_models_dir);
+    std::fs::create_dir_all(&args.out_dir)
+        .map_err(|e| format!("{}: cannot create folder: {e}", args.out_dir.display()))?;
+
+    let steps = (names.len() * (1 + reps as usize + CONFIGURATIONS.len())) as u64;
+    let bar = if args.no_progress {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(steps)
+    };
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+
+    let mut rows = Vec::new();
+    for name in &names {
+        bar.set_message(format!("{name}: loading, f64 reference"));
+        let spec = load_scene(name, &models, width as f32 / height as f32)?;
+        let tris = reference_triangles(&spec, width, height);
+        let reference = reference::render_reference(
+            &tris,
+            &RefOptions {
+                width,
+                height,
+                cull: CullMode::Back,
+                front_face: FrontFace::Ccw,
+            },
+        );
+        let prepared: Vec<Option<Prepared>> = tris
+            .iter()
+            .map(|t| Prepared::new(t, width, height))
+            .collect();
+        let objects: Vec<CoreObject> = spec.objects.iter().map(CoreObject::new).collect();
+        bar.inc(1);
+        let mut runners = Vec::new();
+        for config in CONFIGURATIONS {
+            let input = CoreInput {
+                spec: &spec,
+                objects: &objects,
+                math: config.math,
+                width,
+                height,
+            };
+            runners.push(runner(input, config)?);
+        }
+        let mut times = vec![Vec::with_capacity(reps as usize); runners.len()];
+        for rep in 0..reps {
+            bar.set_message(format!("{name}: timing, round {} of {reps}", rep + 1));
+            for (r, t) in runners.iter_mut().zip(&mut times) {
+                t.push(r.frame()?);
+            }
+            bar.inc(1);
+        }
+        for ((config, r), t) in CONFIGURATIONS.iter().zip(&mut runners).zip(&times) {
+            bar.set_message(format!("{name}: {} against f64", config.label()));
+            let run = r.finish()?;
+            let vertex = vertex_error(
+                &spec,
+                &mvps(&spec, config.math, width, height),
+                width,
+                height,
+            );
+            let errors = compare(
+                &run,
+                config.depth_bits,
+                &reference,
+                &prepared,
+                Tolerance::new(config.subpixel, &vertex),
+            );
+            rows.push(Row {
+                scene: name.clone(),
+                config: *config,
+                time_ms: median(t),
+                errors,
+                vertex,
+            });
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+
+    let info = RunInfo {
+        width,
+        height,
+        reps,
+    };
+    let summary = summarize(&rows);
+    let md_path = args.out_dir.join("speed-vs-error.md");
+    std::fs::write(&md_path, markdown(&info, &summary, &rows))
+        .map_err(|e| format!("{}: cannot write: {e}", md_path.display()))?;
+    let png_path = args.out_dir.join("speed-vs-error.png");
+    plot::write_png(&png_path, &info, &summary)?;
+    eprintln!(
+        "microraster: wrote {} and {}",
+        md_path.display(),
+        png_path.display()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_front_keeps_only_undominated_points() {
+        let pts = [
+            (1.0, 5.0), // front
+            (2.0, 3.0), // front
+            (2.5, 3.0), // dominated by (2, 3)
+            (3.0, 1.0), // front
+            (4.0, 1.0), // dominated by (3, 1)
+            (2.0, 4.0), // dominated by (2, 3)
+            (5.0, 0.5), // front
+            (f64::NAN, 0.0),
+        ];
+        assert_eq!(pareto_front(&pts), vec![0, 1, 3, 6]);
+        // Equal points do not dominate each other.
+        assert_eq!(pareto_front(&[(1.0, 1.0), (1.0, 1.0)]), vec![0, 1]);
+        assert!(pareto_front(&[]).is_empty());
+        // One point is its own front.
+        assert_eq!(pareto_front(&[(3.0, 3.0)]), vec![0]);
+    }
+
+    #[test]
+    fn configurations_cover_the_grid_once() {
+        let mut seen = std::collections::HashSet::new();
+        for c in CONFIGURATIONS {
+            assert!(seen.insert(c));
+            assert!(matches!(c.subpixel, 4 | 8));
+            assert!(matches!(c.depth_bits, 16 | 32));
+        }
+        assert_eq!(seen.len(), 8);
+    }
+
+    #[test]
+    fn median_of_odd_and_even() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+
+    #[test]
+    fn cubes_match_the_reference_up_to_snapping() {
+        let spec = cubes_spec();
+        let (w, h) = (96, 72);
+        let tris = reference_triangles(&spec, w, h);
+        let reference = reference::render_reference(
+            &tris,
+            &RefOptions {
+                width: w,
+                height: h,
+                cull: CullMode::Back,
+                front_face: FrontFace::Ccw,
+            },
+        );
+        let prepared: Vec<_> = tris.iter().map(|t| Prepared::new(t, w, h)).collect();
+        let objects: Vec<CoreObject> = spec.objects.iter().map(CoreObject::new).collect();
+        for config in CONFIGURATIONS {
+            let input = CoreInput {
+                spec: &spec,
+                objects: &objects,
+                math: config.math,
+                width: w,
+                height: h,
+            };
+            let run = runner(input, config).unwrap().finish().unwrap();
+            let v = vertex_error(&spec, &mvps(&spec, config.math, w, h), w, h);
+            if config.math == MathBackend::Libm {
+                assert!(v.window_px < 1e-3, "{config:?} {v:?}");
+            }
+            let e = compare(
+                &run,
+                config.depth_bits,
+                &reference,
+                &prepared,
+                Tolerance::new(config.subpixel, &v),
+            );
+            assert!(e.covered > 1000);
+            assert_eq!(e.unexplained, 0, "{config:?} {e:?}");
+            assert_eq!(e.depth_beyond, 0, "{config:?} {e:?}");
+            assert_eq!(e.color_beyond, 0, "{config:?} {e:?}");
+            // With libm, a handful of edge pixels at most (micromath's
+            // vertex error moves edges by a good part of a pixel here).
+            if config.math == MathBackend::Libm {
+                assert!(e.id_diff * 50 < e.covered, "{config:?} {e:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn report_writes_table_and_plot() {
+        let dir = tempfile::TempDir::new().unwrap();
+        let args = ReportArgs {
+            which: "speed-vs-error".into(),
+            out_dir: dir.path().join("out"),
+            quick: true,
+            size: Some((64, 48)),
+            reps: Some(1),
+            scenes: Some(vec!["cubes".into()]),
+            models: None,
+            no_progress: true,
+        };
+        run(&args).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("out/speed-vs-error.md")).unwrap();
+        assert!(md.contains("S8 u16 libm"));
+        assert_eq!(md.matches("| cubes |").count(), 8);
+        let png = std::fs::read(dir.path().join("out/speed-vs-error.png")).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+    }
+
+    #[test]
+    fn normal_colours_of_a_cube_corner() {
+        let c = normal_colors(&cubes::CUBE_VERTICES, &cubes::CUBE_INDICES);
+        // Corner (1, -1, -1): the normal points along +x, -y, -z.
+        assert!(
+            c[0].r() > 128 && c[0].g() < 127 && c[0].b() < 127,
+            "{:?}",
+            c[0]
+        );
+        // Corner (-1, 1, 1): the opposite.
+        assert!(
+            c[6].r() < 127 && c[6].g() > 128 && c[6].b() > 128,
+            "{:?}",
+            c[6]
+        );
+    }
+}
