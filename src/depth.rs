@@ -212,13 +212,28 @@ impl<W: DepthWord> DepthBuffer for [W] {
         let le = func == DepthFunc::LessEqual;
         let mut written = 0u32;
         let mut z = z0;
-        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-            let zw = W::from_z32_16(z);
-            let pass = zw < *dp || (le && zw == *dp);
-            *dp = if pass { zw } else { *dp };
-            *cp = if pass { px } else { *cp };
-            written += pass as u32;
-            z = z.wrapping_add(dz);
+        if cfg!(target_pointer_width = "64") {
+            // Branch-free, so the compiler can vectorize it (SSE/AVX).
+            for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+                let zw = W::from_z32_16(z);
+                let pass = zw < *dp || (le && zw == *dp);
+                *dp = if pass { zw } else { *dp };
+                *cp = if pass { px } else { *cp };
+                written += pass as u32;
+                z = z.wrapping_add(dz);
+            }
+        } else {
+            // Microcontrollers have no vectors to fill: store only where
+            // the test passes (the same results, fewer instructions).
+            for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+                let zw = W::from_z32_16(z);
+                if zw < *dp || (le && zw == *dp) {
+                    *dp = zw;
+                    *cp = px;
+                    written += 1;
+                }
+                z = z.wrapping_add(dz);
+            }
         }
         written
     }

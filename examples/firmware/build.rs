@@ -10,7 +10,8 @@
 //! the firmware, rendered here by the same core crate on the host. On
 //! purpose by the other path: the whole frame set up once in a [`Frame`]
 //! and rendered as one 240-row strip, where the firmware submits the scene
-//! to a `StripRenderer` for every strip of 15 (or 8) rows. The hash is the
+//! strip by strip (set up once into a `Frame`, or submitted to a
+//! `StripRenderer` for every strip with `--features immediate`). The hash is the
 //! firmware's: `microraster_scenes::checksum::FrameChecksum` over the
 //! `Rgb565` pixels, rows top to bottom.
 
@@ -33,28 +34,42 @@ struct Board {
     strip_rows: u32,
 }
 
-fn board(target: &str) -> Board {
+/// The board for `target`, and its strip height for the mode: immediate
+/// mode (`immediate` feature) needs no setup storage, so its strips can
+/// be taller; set-up-once mode keeps the frame's set-up triangles
+/// (`SETUP_CAPACITY` of them, 112 B each) and pays for them in strip rows.
+fn board(target: &str, immediate: bool) -> Board {
+    let rows = |setup_once: u32, immediate_rows: u32| {
+        if immediate {
+            immediate_rows
+        } else {
+            setup_once
+        }
+    };
     match target {
         "thumbv7em-none-eabihf" => Board {
             name: "mps2-an386",
             core: "Cortex-M4F",
-            // 15 rows of colour and depth (18.75 KB) leave room in the
-            // 24 KB budget for the frame's processed vertices (1.1 KB).
+            // Of the 24 KB budget: 12 rows of colour and depth (15 KB) and
+            // the set-up triangles (3.5 KB), or 15 rows (18.75 KB) in
+            // immediate mode; both keep the frame's processed vertices
+            // (1.1 KB).
             memory: "mps2.x",
-            strip_rows: 15,
+            strip_rows: rows(12, 15),
         },
         "thumbv7m-none-eabi" => Board {
             name: "mps2-an385",
             core: "Cortex-M3",
             memory: "mps2.x",
-            strip_rows: 15,
+            strip_rows: rows(12, 15),
         },
-        // 16 KB of RAM: 8 rows of colour and depth are 10 KB.
+        // 16 KB of RAM: 5 rows (6.25 KB) and the set-up triangles, or 8
+        // rows (10 KB) in immediate mode.
         "thumbv6m-none-eabi" => Board {
             name: "microbit",
             core: "Cortex-M0",
             memory: "microbit.x",
-            strip_rows: 8,
+            strip_rows: rows(5, 8),
         },
         other => panic!(
             "no board for target {other}: build with --target thumbv7em-none-eabihf \
@@ -91,7 +106,8 @@ fn host_checksum(depth: bool) -> u64 {
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let target = env::var("TARGET").unwrap();
-    let b = board(&target);
+    let immediate = env::var_os("CARGO_FEATURE_IMMEDIATE").is_some();
+    let b = board(&target, immediate);
     let depth = env::var_os("CARGO_FEATURE_NO_DEPTH").is_none();
 
     let memory = fs::read_to_string(format!("memory/{}", b.memory)).unwrap();

@@ -53,7 +53,11 @@ use display::HashDisplay;
 #[cfg(feature = "flat")]
 use microraster::pixelcolor::Rgb888;
 use microraster::pixelcolor::{Rgb565, RgbColor};
-use microraster::{Config, ProcessedVertex, StripDrawer, StripRenderer, Submit};
+#[cfg(not(feature = "immediate"))]
+use microraster::SetupTriangle;
+#[cfg(feature = "immediate")]
+use microraster::StripRenderer;
+use microraster::{Config, ProcessedVertex, StripDrawer, Submit};
 use microraster_scenes::cubes;
 use panic_semihosting as _;
 
@@ -63,6 +67,11 @@ include!(concat!(env!("OUT_DIR"), "/board.rs"));
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
 const STRIP_LEN: usize = WIDTH as usize * STRIP_ROWS;
+/// Set-up triangles the frame can hold: the four cubes' 48 triangles,
+/// of which at most half face the camera (the rest are culled as back
+/// faces before storage), with room for clipped pieces.
+#[cfg(not(feature = "immediate"))]
+const SETUP_CAPACITY: usize = 32;
 
 /// The strip buffer's pixel: the display's own `Rgb565`, or with `flat`
 /// [`Flat565`].
@@ -126,6 +135,7 @@ fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
 /// Submits the four cubes to one strip (triangle ids as in
 /// `cubes::for_each_cube`); triangles wholly above or below the strip are
 /// skipped before setup.
+#[cfg(feature = "immediate")]
 fn submit<D>(strip: &mut StripRenderer<'_, StripPixel, D>, vertices: &Vertices)
 where
     D: microraster::DepthBuffer + ?Sized,
@@ -174,6 +184,8 @@ fn ratio(n: u64, d: u64) -> (u64, u64) {
 fn main() -> ! {
     static mut COLOR: [StripPixel; STRIP_LEN] = [BLACK; STRIP_LEN];
     static mut VERTICES: Vertices = [ProcessedVertex::EMPTY; 32];
+    #[cfg(not(feature = "immediate"))]
+    static mut SETUP: [SetupTriangle; SETUP_CAPACITY] = [SetupTriangle::EMPTY; SETUP_CAPACITY];
     #[cfg(not(feature = "no-depth"))]
     static mut DEPTH: [u16; STRIP_LEN] = [0; STRIP_LEN];
 
@@ -190,14 +202,38 @@ fn main() -> ! {
     let mut drawer = StripDrawer::new(&mut COLOR[..], depth, BLACK);
     let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
 
-    // The frame: camera matrices, then every strip.
+    // The frame: camera matrices and the vertex stage, (in set-up-once
+    // mode) every triangle set up into the frame's storage, then every
+    // strip.
     let t0 = display.clock.now();
     let mvps = cubes::mvps(WIDTH, HEIGHT);
-    let t_vertex = display.clock.now();
     process(config, &mvps, VERTICES);
-    let vertex_ticks = display.clock.now() - t_vertex;
     let vertices: &Vertices = VERTICES;
-    let drawn = drawer.draw(&mut display, config, |strip| submit(strip, vertices));
+    #[cfg(feature = "immediate")]
+    let (drawn, setup_ticks) = {
+        let setup_ticks = display.clock.now() - t0;
+        let drawn = drawer.draw(&mut display, config, |strip| submit(strip, vertices));
+        (drawn, setup_ticks)
+    };
+    #[cfg(not(feature = "immediate"))]
+    let (drawn, setup_ticks) = {
+        let mut frame = match microraster::Frame::new(config, SETUP) {
+            Ok(f) => f,
+            Err(e) => {
+                hprintln!("FAIL: frame: {}", e);
+                exit(false)
+            }
+        };
+        for (i, cache) in vertices.chunks_exact(8).enumerate() {
+            let id = (i * cubes::CUBE_INDICES.len()) as u32;
+            if let Err(e) = frame.submit_processed_mesh(&cubes::MESH, id, cache) {
+                hprintln!("FAIL: setup: {}", e);
+                exit(false)
+            }
+        }
+        let setup_ticks = display.clock.now() - t0;
+        (drawer.draw_frame(&mut display, &frame), setup_ticks)
+    };
     let frame_ticks = display.clock.now() - t0;
 
     let written = match drawn {
@@ -210,11 +246,12 @@ fn main() -> ! {
     let checksum = display.checksum();
     let (statics, stack) = ram_use();
 
-    // Where the instructions went, measured apart on the same code: one
-    // strip's clear (done once per strip), the vertex stage (once per
-    // frame), and the scene submitted to a one-row strip (cull, clip and
-    // setup of every triangle that reaches it, which immediate mode
-    // repeats for every strip, plus that one row's pixels: an estimate).
+    // Where the instructions went. Set-up-once mode measures them apart in
+    // the frame itself: the vertex stage and setup (once per frame), the
+    // strip clears (measured on one strip, done once per strip), the rest
+    // rasterization. Immediate mode repeats cull, clip and setup for every
+    // strip: that is estimated as the scene submitted to a one-row strip
+    // (which includes that one row's pixels), times the strips.
     let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
     let mut clock = display.clock;
     let t = clock.now();
@@ -222,8 +259,11 @@ fn main() -> ! {
     #[cfg(not(feature = "no-depth"))]
     DEPTH.fill(u16::MAX);
     let clear_ticks = (clock.now() - t) * strips;
-    let t = clock.now();
-    {
+    #[cfg(not(feature = "immediate"))]
+    let geometry_ticks = setup_ticks;
+    #[cfg(feature = "immediate")]
+    let geometry_ticks = {
+        let t = clock.now();
         let (row, rest) = COLOR.split_at_mut(WIDTH as usize);
         core::hint::black_box(rest);
         #[cfg(not(feature = "no-depth"))]
@@ -232,8 +272,8 @@ fn main() -> ! {
         let z = &mut microraster::NoDepth;
         let mut one = StripRenderer::new(config, HEIGHT / 2, HEIGHT / 2 + 1, row, z).unwrap();
         submit(&mut one, vertices);
-    }
-    let geometry_ticks = (clock.now() - t) * strips + vertex_ticks;
+        (clock.now() - t) * strips + setup_ticks
+    };
 
     let frame = instr(frame_ticks);
     let shown = instr(display.ticks);
@@ -244,7 +284,7 @@ fn main() -> ! {
     let per_px = |n: u64| ratio(n, written);
 
     hprintln!(
-        "microraster firmware: {} ({}), {}x{} Rgb565, depth {}, colour {}, {} strips of {} rows",
+        "microraster firmware: {} ({}), {}x{} Rgb565, depth {}, colour {}, {}, {} strips of {} rows",
         BOARD,
         CORE,
         WIDTH,
@@ -258,6 +298,11 @@ fn main() -> ! {
             "flat"
         } else {
             "interpolated"
+        },
+        if cfg!(feature = "immediate") {
+            "immediate"
+        } else {
+            "set up once"
         },
         strips,
         STRIP_ROWS,
@@ -281,13 +326,17 @@ fn main() -> ! {
     let (a, b) = per_px(clears);
     hprintln!("    strip clears           {} ({}.{}/px)", clears, a, b);
     let (a, b) = per_px(geometry);
-    hprintln!(
-        "    geometry x {} strips   {} ({}.{}/px)",
-        strips,
-        geometry,
-        a,
-        b
-    );
+    if cfg!(feature = "immediate") {
+        hprintln!(
+            "    geometry x {} strips   {} ({}.{}/px)",
+            strips,
+            geometry,
+            a,
+            b
+        );
+    } else {
+        hprintln!("    geometry (once)        {} ({}.{}/px)", geometry, a, b);
+    }
     let (a, b) = per_px(raster);
     hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
     match stack {
