@@ -303,7 +303,9 @@ fn culled_object<K: Sink + ?Sized>(
 /// One submission, run once to count (if it might not fit) and once to
 /// deliver.
 trait Job {
-    /// An upper bound on the pieces it yields.
+    /// The most pieces it can yield, found in O(1).
+    fn max_pieces(&self) -> usize;
+    /// An upper bound on the pieces it yields, at most `max_pieces`.
     fn bound(&self, stage: &Stage) -> usize;
     /// Runs it, counting into `stats` and handing pieces to `sink`.
     fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K);
@@ -314,7 +316,7 @@ fn run_job<const S: u32, K: Sink + ?Sized, J: Job>(
     job: &J,
 ) -> Result<(), Error> {
     let room = parts.sink.room();
-    if job.bound(parts.stage) > room {
+    if job.max_pieces() > room && job.bound(parts.stage) > room {
         let mut count = Counter(0);
         job.run::<S, _>(parts.stage, &mut Stats::default(), &mut count);
         if count.0 > room {
@@ -337,6 +339,9 @@ struct TriangleJob {
 }
 
 impl Job for TriangleJob {
+    fn max_pieces(&self) -> usize {
+        MAX_PIECES
+    }
     fn bound(&self, _: &Stage) -> usize {
         MAX_PIECES
     }
@@ -353,8 +358,11 @@ struct MeshJob<'m> {
 }
 
 impl Job for MeshJob<'_> {
-    fn bound(&self, _: &Stage) -> usize {
+    fn max_pieces(&self) -> usize {
         self.mesh.indices.len().saturating_mul(MAX_PIECES)
+    }
+    fn bound(&self, _: &Stage) -> usize {
+        self.max_pieces()
     }
     fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
         for i in 0..self.mesh.indices.len() {
@@ -377,9 +385,19 @@ struct ProcessedJob<'m> {
 }
 
 impl Job for ProcessedJob<'_> {
-    /// One piece per triangle that needs no clipping, seven for the rest
-    /// (a cheap pass over the outcodes).
+    fn max_pieces(&self) -> usize {
+        self.mesh.indices.len().saturating_mul(MAX_PIECES)
+    }
+
+    /// One piece per triangle that needs no clipping, seven for the rest.
+    /// Where no vertex needs clipping (most frames), that is one piece per
+    /// triangle, found by one sequential pass over the vertices instead
+    /// of one over the triangles.
     fn bound(&self, _: &Stage) -> usize {
+        let n = self.mesh.indices.len();
+        if !self.cache.iter().any(|v| v.code & outcode::CLIP != 0) {
+            return n;
+        }
         let code = |k: u32| self.cache.get(k as usize).map_or(0, |v| v.code);
         self.mesh.indices.iter().fold(0usize, |n, idx| {
             let or = code(idx[0]) | code(idx[1]) | code(idx[2]);
