@@ -121,7 +121,7 @@ for b in "${boards[@]}"; do
     render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
     render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
     clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
-    geometry=$(sed -n 's/^ *geometry x [0-9]* strips *\([0-9]*\) .*/\1/p' "$out")
+    geometry=$(sed -n -E 's/^ *geometry (x [0-9]+ strips|\(once\)) +([0-9]+) .*/\2/p' "$out")
     raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
     statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
     stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
