@@ -339,14 +339,10 @@ mod tests {
             Vec3::new(-2.0, 2.0, 2.5),
             Vec3::new(0.5, 0.5, f32::NAN),
         ];
-        let indices = [
-            [0, 1, 2],
-            [1, 3, 2],
-            [2, 4, 0],
-            [0, 4, 3],
-            [1, 5, 2],
-            [0, 9, 1],
-        ];
+        // Index 9 is out of range, index 5 a NaN vertex.
+        let flat = [0u32, 1, 2, 1, 3, 2, 2, 4, 0, 0, 4, 3, 1, 5, 2, 0, 9, 1];
+        let indices: [[u32; 3]; 6] =
+            core::array::from_fn(|i| [flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]]);
         let colors = [Rgb888::new(200, 10, 10); 6];
         let mesh = Mesh {
             positions: &positions,
