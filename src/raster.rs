@@ -108,7 +108,7 @@ impl_edge_int!(i32, from_i32);
 impl_edge_int!(i64, from_i64);
 
 /// The largest vertex span (max - min, in `Sub<S>` units, in x and in y)
-/// for which every edge value [`draw`] computes fits `i32`: 45,000 units,
+/// for which every edge value `draw` computes fits `i32`: 45,000 units,
 /// 175 pixels at 8 subpixel bits, 2,812 at 4.
 ///
 /// Proof: `E_k(p) = (b - a) x (p - a)` is twice the signed area of the
