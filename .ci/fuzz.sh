@@ -1,22 +1,47 @@
 #!/usr/bin/env bash
-# Builds the cargo-fuzz targets in fuzz/ and runs each one for a while.
+# Builds the cargo-fuzz targets in fuzz/ and runs each one for a while,
+# starting from the committed seed corpus (fuzz/seeds/<target>/, pieces of
+# the shared models written by fuzz/seeds.py) copied into the run's corpus.
+# Two builds: the default one (libm the core's default float backend, with
+# micromath arms through `*_with::<Micromath>`) and one with micromath as
+# the default backend (`--no-default-features`, its own target dir), so
+# `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
 # Exits non-zero when a target crashes (panic, overflow, assertion, ASan
 # report); the crashing input is left in fuzz/artifacts/<target>/.
 #
-#   bash .ci/fuzz.sh                      # about a minute per target (CI)
-#   FUZZ_SECONDS=3600 bash .ci/fuzz.sh    # the long run: an hour per target
+#   bash .ci/fuzz.sh                      # CI: a minute per target
+#                                         # (40 s libm build, 20 s micromath)
+#   FUZZ_SECONDS=1800 bash .ci/fuzz.sh    # 30 min per target, one after the
+#                                         # other (docs/accuracy.md has the
+#                                         # long run, both targets at once)
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
+#   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
 #
-# Reproduce a crash: cd fuzz && cargo +nightly fuzz run -O -a <target> <file>
+# Reproduce a crash:
+#   cd fuzz && cargo +nightly fuzz run -O -a <target> <file>
+#   cd fuzz && cargo +nightly fuzz run -O -a --no-default-features \
+#     --target-dir target/micromath <target> <file>      # micromath build
 # Needs a nightly toolchain (ASan, sanitizer coverage) and cargo-fuzz,
-# installed here when missing (about 30 s).
+# installed here when missing (a few minutes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-SECONDS_PER_TARGET=${FUZZ_SECONDS:-60}
+# FUZZ_SECONDS per target in all: two thirds on the libm build, a third
+# on the micromath build (unless FUZZ_BUILDS names one only).
+TOTAL_SECONDS=${FUZZ_SECONDS:-60}
 TARGETS=${FUZZ_TARGETS:-"frame strip_renderer"}
+BUILDS=${FUZZ_BUILDS:-"libm micromath"}
+if [ "$(echo $BUILDS | wc -w)" -gt 1 ]; then
+  MICROMATH_SECONDS=$(( TOTAL_SECONDS / 3 ))
+  SECONDS_PER_TARGET=$(( TOTAL_SECONDS - MICROMATH_SECONDS ))
+else
+  MICROMATH_SECONDS=$TOTAL_SECONDS
+  SECONDS_PER_TARGET=$TOTAL_SECONDS
+fi
 JOBS=${FUZZ_JOBS:-1}
+# Inputs grow to real meshes: a 2,400-triangle piece is about 25 KB.
+MAX_LEN=${FUZZ_MAX_LEN:-32768}
 
 if ! rustup toolchain list | grep -q '^nightly'; then
   rustup toolchain install nightly --profile minimal
@@ -26,29 +51,48 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
 fi
 
 cd fuzz
+build_args() {
+  case "$1" in
+    libm) ;;
+    micromath) echo "--no-default-features --target-dir target/micromath" ;;
+    *) echo "unknown build $1" >&2; exit 2 ;;
+  esac
+}
 # -O: optimised; -a: debug assertions. fuzz/Cargo.toml's release profile
 # also turns overflow checks on.
-cargo +nightly fuzz build -O -a
+for b in $BUILDS; do
+  # shellcheck disable=SC2046
+  cargo +nightly fuzz build -O -a $(build_args "$b")
+done
 mkdir -p target/logs
 status=0
 for t in $TARGETS; do
   mkdir -p "corpus/$t"
-  echo "== fuzz $t for ${SECONDS_PER_TARGET}s (jobs: $JOBS)"
-  log="target/logs/$t.log"
-  set +e
-  cargo +nightly fuzz run -O -a "$t" --jobs "$JOBS" -- \
-    -max_total_time="$SECONDS_PER_TARGET" -max_len=4096 -timeout=20 \
-    -rss_limit_mb=4096 -print_final_stats=1 >"$log" 2>&1
-  rc=$?
-  set -e
-  grep -E 'stat::number_of_executed_units|stat::peak_rss_mb|^Done [0-9]+ runs' "$log" || true
-  if [ "$rc" -ne 0 ]; then
-    echo "!! $t failed (exit $rc); the end of $log:"
-    tail -n 60 "$log"
-    ls -l "artifacts/$t" 2>/dev/null || true
-    status=1
-  else
-    echo "ok: $t ran clean ($(ls "corpus/$t" | wc -l) inputs in its corpus)"
+  if [ -d "seeds/$t" ]; then
+    cp -n seeds/"$t"/* "corpus/$t/" 2>/dev/null || true
   fi
+  for b in $BUILDS; do
+    secs=$SECONDS_PER_TARGET
+    [ "$b" = micromath ] && secs=$MICROMATH_SECONDS
+    echo "== fuzz $t ($b build) for ${secs}s (jobs: $JOBS)"
+    log="target/logs/$t-$b.log"
+    set +e
+    # shellcheck disable=SC2046
+    cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "corpus/$t" --jobs "$JOBS" -- \
+      -max_total_time="$secs" -max_len="$MAX_LEN" -timeout=30 \
+      -rss_limit_mb=4096 -print_final_stats=1 >"$log" 2>&1
+    rc=$?
+    set -e
+    grep -E 'stat::number_of_executed_units|stat::peak_rss_mb|^Done [0-9]+ runs' "$log" || true
+    grep -E '^#[0-9]+' "$log" | tail -n 1 || true
+    if [ "$rc" -ne 0 ]; then
+      echo "!! $t ($b build) failed (exit $rc); the end of $log:"
+      tail -n 60 "$log"
+      ls -l "artifacts/$t" 2>/dev/null || true
+      status=1
+    else
+      echo "ok: $t ($b build) ran clean ($(ls "corpus/$t" | wc -l) inputs in its corpus)"
+    fi
+  done
 done
 exit "$status"

@@ -79,8 +79,13 @@ impl FloatFns for Micromath {
     /// steps (about `1e-6` relative): `look_at` normalises with it.
     #[inline]
     fn sqrt(x: f32) -> f32 {
-        if x == 0.0 {
+        // 0 and infinity are their own roots (a Newton step on infinity
+        // would compute inf / inf = NaN); NaN and negatives stay NaN.
+        if x == 0.0 || x == f32::INFINITY {
             return x;
+        }
+        if !(x > 0.0) {
+            return f32::NAN;
         }
         let mut y = micromath::F32Ext::sqrt(x);
         if y > 0.0 && y.is_finite() {
@@ -478,6 +483,13 @@ mod tests {
             assert!(((r as f64 - exact) / exact).abs() < 1e-5, "sqrt({x}) = {r}");
         }
         assert_eq!(Micromath::sqrt(0.0), 0.0);
+        // Found by fuzzing: a squared distance that overflowed to infinity
+        // gave a NaN root (and a NaN bounding-sphere radius).
+        assert_eq!(Micromath::sqrt(f32::INFINITY), f32::INFINITY);
+        assert!(Micromath::sqrt(f32::NAN).is_nan());
+        assert!(Micromath::sqrt(-1.0).is_nan());
+        let big = Micromath::sqrt(f32::MAX) as f64;
+        assert!((big / (f32::MAX as f64).sqrt() - 1.0).abs() < 1e-6, "{big}");
     }
 
     #[test]

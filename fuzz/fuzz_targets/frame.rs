@@ -1,8 +1,9 @@
-//! Frame setup and strip rendering from arbitrary vertices, matrices, frame
-//! sizes and row ranges (see `microraster_fuzz::run_frame`).
+//! Frame setup and rendering from arbitrary input: submissions through
+//! every `Submit` path, `Frame::clear`, strip splits, bins, wrong calls,
+//! every pixel format (see `microraster_fuzz::run_frame`).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use microraster_fuzz::{run_frame, FrameInput};
+use microraster_fuzz::{run_frame, Input};
 
-fuzz_target!(|input: FrameInput| run_frame(&input));
+fuzz_target!(|input: Input| run_frame(&input));
