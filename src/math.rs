@@ -84,7 +84,7 @@ impl FloatFns for Micromath {
         if x == 0.0 || x == f32::INFINITY {
             return x;
         }
-        if !(x > 0.0) {
+        if x.is_nan() || x < 0.0 {
             return f32::NAN;
         }
         let mut y = micromath::F32Ext::sqrt(x);
