@@ -62,13 +62,13 @@ impl Bins<'_> {
 
 /// The strips (of `r` rows) triangle `t` touches.
 #[inline]
-fn strip_range(t: &SetupTriangle, r: u32) -> core::ops::RangeInclusive<u32> {
+fn strip_range<const N: usize>(t: &SetupTriangle<N>, r: u32) -> core::ops::RangeInclusive<u32> {
     t.min_y as u32 / r..=t.max_y as u32 / r
 }
 
 /// Bin entries for strips of `r >= 1` rows: one per (triangle, strip it
 /// touches); saturates at `usize::MAX` (then no storage can hold them).
-pub(crate) fn entries(triangles: &[SetupTriangle], r: u32) -> usize {
+pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], r: u32) -> usize {
     triangles.iter().fold(0usize, |n, t| {
         let range = strip_range(t, r);
         n.saturating_add((range.end() - range.start()) as usize + 1)
@@ -77,9 +77,9 @@ pub(crate) fn entries(triangles: &[SetupTriangle], r: u32) -> usize {
 
 /// Sorts `triangles` of a frame of `config` into bins; see
 /// [`Frame::bin`](crate::Frame::bin).
-pub(crate) fn bin<'b>(
+pub(crate) fn bin<'b, const N: usize>(
     config: &Config,
-    triangles: &[SetupTriangle],
+    triangles: &[SetupTriangle<N>],
     strip_rows: u32,
     offsets: &'b mut [u32],
     items: &'b mut [u32],

@@ -28,13 +28,26 @@
 use crate::math::Vec4;
 use heapless::Vec;
 
-/// A clip-space vertex with its colour (linear `f32` channels, 0..=255).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ClipVertex {
+/// A clip-space vertex with its `N` varyings: the values interpolated
+/// (perspective-correct) over the triangle and handed to the fragment
+/// shader. With the default `N = 3` and [`VertexColor`](crate::VertexColor)
+/// they are red, green and blue in `0.0..=255.0`; other shaders document
+/// their layout (see [`crate::shade`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipVertex<const N: usize = 3> {
     /// Clip-space position.
     pub pos: Vec4,
-    /// Red, green, blue in `0.0..=255.0`.
-    pub color: [f32; 3],
+    /// The varyings.
+    pub varyings: [f32; N],
+}
+
+impl<const N: usize> Default for ClipVertex<N> {
+    fn default() -> Self {
+        ClipVertex {
+            pos: Vec4::new(0.0, 0.0, 0.0, 0.0),
+            varyings: [0.0; N],
+        }
+    }
 }
 
 /// Outcode bits.
@@ -106,7 +119,7 @@ pub fn outcode(p: Vec4, gx: f32, gy: f32) -> u16 {
 }
 
 /// The clipped polygon: at most 9 vertices.
-pub type Polygon = Vec<ClipVertex, 9>;
+pub type Polygon<const N: usize = 3> = Vec<ClipVertex<N>, 9>;
 
 /// Signed distance to the plane `bit` (inside where `>= 0`), in `f64` so
 /// that neither `g * w` nor a difference of two finite `f32` values can
@@ -129,15 +142,15 @@ fn distance(bit: u16, p: Vec4, gx: f64, gy: f64) -> f64 {
 /// (outside, `dout`) crosses plane `bit`, interpolated in `f64` and then put
 /// exactly on the plane (so a `t` that rounds to 1 for extreme `w` ratios
 /// still yields a point inside the guard band).
-fn intersect(
+fn intersect<const N: usize>(
     bit: u16,
-    vi: &ClipVertex,
-    vo: &ClipVertex,
+    vi: &ClipVertex<N>,
+    vo: &ClipVertex<N>,
     di: f64,
     dout: f64,
     gx: f64,
     gy: f64,
-) -> ClipVertex {
+) -> ClipVertex<N> {
     use outcode::*;
     // Weights of the outside and inside vertex, each computed directly (not
     // one as 1 minus the other), so a vertex with a huge `w` keeps its tiny
@@ -160,19 +173,23 @@ fn intersect(
         GUARD_BOTTOM => y = -gy * w,
         _ => y = gy * w,
     }
-    let c = |k: usize| l(vi.color[k], vo.color[k]) as f32;
     ClipVertex {
         pos: Vec4::new(x as f32, y as f32, z as f32, w as f32),
-        color: [c(0), c(1), c(2)],
+        varyings: core::array::from_fn(|k| l(vi.varyings[k], vo.varyings[k]) as f32),
     }
 }
 
 /// Clips the triangle against the planes in `mask` (a subset of
 /// [`outcode::CLIP`]). Returns the convex polygon, possibly empty.
-pub fn clip_triangle(tri: &[ClipVertex; 3], mask: u16, gx: f32, gy: f32) -> Polygon {
+pub fn clip_triangle<const N: usize>(
+    tri: &[ClipVertex<N>; 3],
+    mask: u16,
+    gx: f32,
+    gy: f32,
+) -> Polygon<N> {
     use outcode::*;
     let (gx, gy) = (gx as f64, gy as f64);
-    let mut poly = Polygon::new();
+    let mut poly = Polygon::<N>::new();
     for v in tri {
         // Capacity 9 >= 3: cannot fail.
         let _ = poly.push(*v);
@@ -181,7 +198,7 @@ pub fn clip_triangle(tri: &[ClipVertex; 3], mask: u16, gx: f32, gy: f32) -> Poly
         if mask & bit == 0 {
             continue;
         }
-        let mut out = Polygon::new();
+        let mut out = Polygon::<N>::new();
         let n = poly.len();
         for i in 0..n {
             let a = &poly[i];
@@ -223,7 +240,7 @@ mod tests {
     fn cv(x: f32, y: f32, z: f32, w: f32) -> ClipVertex {
         ClipVertex {
             pos: Vec4::new(x, y, z, w),
-            color: [0.0; 3],
+            varyings: [0.0; 3],
         }
     }
 

@@ -133,6 +133,21 @@ pub enum Error {
         /// The slice length.
         actual: usize,
     },
+    /// A texture whose texel slice does not hold `width * height` texels,
+    /// or with a side of 0 or above
+    /// [`MAX_TEXTURE_SIDE`](crate::shade::MAX_TEXTURE_SIDE).
+    TextureSize {
+        /// The width given.
+        width: u32,
+        /// The height given.
+        height: u32,
+        /// The texels given.
+        texels: usize,
+    },
+    /// [`Lighting::new`](crate::shade::Lighting::new) with more than
+    /// [`MAX_LIGHTS`](crate::shade::MAX_LIGHTS) lights, a zero or
+    /// non-finite direction, or a non-finite intensity.
+    InvalidLighting,
 }
 
 impl core::fmt::Display for Error {
@@ -178,6 +193,20 @@ impl core::fmt::Display for Error {
             Error::DepthBufferSize { expected, actual } => {
                 write!(f, "depth buffer holds {actual} values, expected {expected}")
             }
+            Error::TextureSize {
+                width,
+                height,
+                texels,
+            } => write!(
+                f,
+                "texture of {width}x{height} texels given {texels} (sides 1..={})",
+                crate::shade::MAX_TEXTURE_SIDE
+            ),
+            Error::InvalidLighting => write!(
+                f,
+                "lighting needs at most {} lights with finite, non-zero directions and finite colours",
+                crate::shade::MAX_LIGHTS
+            ),
         }
     }
 }

@@ -270,6 +270,24 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         })
     }
 
+    /// [`StripDrawer::draw_frame`] for a frame of `N` varyings, coloured
+    /// by `fragment` (see [`Frame::render_rows_shaded`]).
+    pub fn draw_frame_shaded<T, const S: u32, const N: usize, F>(
+        &mut self,
+        target: &mut T,
+        frame: &Frame<'_, S, N>,
+        fragment: &F,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+        F: crate::shade::FragmentShader<N>,
+    {
+        self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
+            frame.render_rows_shaded(y0, y1, color, depth, fragment)
+        })
+    }
+
     /// The strip loop shared by both modes: check, then per strip clear,
     /// render (`render(y0, y1, color, depth)`) and push.
     fn for_each_strip<T, R>(

@@ -23,16 +23,17 @@ use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
 use crate::raster::{draw, Strip};
 use crate::setup::SetupTriangle;
+use crate::shade::{FragmentShader, VertexColor};
 use crate::stats::{RenderStats, Stats};
 
 /// The caller's setup storage and how much of it is used.
 #[derive(Debug)]
-pub struct Store<'s> {
-    storage: &'s mut [SetupTriangle],
+pub struct Store<'s, const N: usize = 3> {
+    storage: &'s mut [SetupTriangle<N>],
     len: usize,
 }
 
-impl Sink for Store<'_> {
+impl<const N: usize> Sink<N> for Store<'_, N> {
     fn room(&self) -> usize {
         self.storage.len().saturating_sub(self.len)
     }
@@ -40,7 +41,7 @@ impl Sink for Store<'_> {
         self.storage.len()
     }
     #[inline]
-    fn take(&mut self, t: &SetupTriangle) {
+    fn take(&mut self, t: &SetupTriangle<N>) {
         if let Some(slot) = self.storage.get_mut(self.len) {
             *slot = *t;
             self.len += 1;
@@ -49,7 +50,9 @@ impl Sink for Store<'_> {
 }
 
 /// A frame being built and rendered, at `S` subpixel bits (8 by default;
-/// 4 is the other supported value, see [`Frame::with_subpixel_bits`]).
+/// 4 is the other supported value, see [`Frame::with_subpixel_bits`]),
+/// with `N` varyings per vertex (3 by default: a colour; see
+/// [`crate::shade`] and [`Frame::render_rows_shaded`]).
 ///
 /// ```
 /// use microraster::prelude::*;
@@ -77,9 +80,9 @@ impl Sink for Store<'_> {
 /// assert!(written > 400);
 /// ```
 #[derive(Debug)]
-pub struct Frame<'s, const S: u32 = 8> {
+pub struct Frame<'s, const S: u32 = 8, const N: usize = 3> {
     stage: Stage,
-    store: Store<'s>,
+    store: Store<'s, N>,
     stats: Stats,
 }
 
@@ -91,9 +94,10 @@ impl<'s> Frame<'s> {
     }
 }
 
-impl<'s, const S: u32> Frame<'s, S> {
+impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     /// A new, empty frame at `S` subpixel bits (4 or 8; anything else does
-    /// not compile), e.g. `Frame::<4>::with_subpixel_bits(config, storage)`.
+    /// not compile), e.g. `Frame::<4>::with_subpixel_bits(config, storage)`;
+    /// the storage's type sets the number of varyings.
     ///
     /// ```compile_fail
     /// let mut storage = [microraster::SetupTriangle::EMPTY; 4];
@@ -101,7 +105,7 @@ impl<'s, const S: u32> Frame<'s, S> {
     /// ```
     pub fn with_subpixel_bits(
         config: Config,
-        storage: &'s mut [SetupTriangle],
+        storage: &'s mut [SetupTriangle<N>],
     ) -> Result<Self, Error> {
         const { check_subpixel_bits::<S>() };
         check_size(&config)?;
@@ -132,7 +136,7 @@ impl<'s, const S: u32> Frame<'s, S> {
     }
 
     /// The stored set-up triangles, in drawing order.
-    pub fn triangles(&self) -> &[SetupTriangle] {
+    pub fn triangles(&self) -> &[SetupTriangle<N>] {
         self.store.storage.get(..self.store.len).unwrap_or(&[])
     }
 
@@ -176,17 +180,16 @@ impl<'s, const S: u32> Frame<'s, S> {
         )
     }
 
-    /// Renders strip `strip` (rows `strip * strip_rows ..`, the last strip
-    /// possibly shorter) of a binned frame into buffers that hold exactly
-    /// those rows. The same pixels as [`Frame::render_rows`] for those
-    /// rows. [`Error::BinsMismatch`] if `bins` were made for another frame,
-    /// or before triangles were added to this one.
-    pub fn render_strip<C: PixelFormat, D: DepthBuffer + ?Sized>(
+    /// [`Frame::render_strip`] with the fragment shader `fragment` (see
+    /// [`crate::shade`]): the same pixels as
+    /// [`Frame::render_rows_shaded`] for those rows.
+    pub fn render_strip_shaded<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
         bins: &Bins<'_>,
         strip: u32,
         color: &mut [C],
         depth: &mut D,
+        fragment: &F,
     ) -> Result<RenderStats, Error> {
         if !bins.belong_to(&self.stage.config, self.store.len) {
             return Err(Error::BinsMismatch);
@@ -199,6 +202,7 @@ impl<'s, const S: u32> Frame<'s, S> {
             y1,
             color,
             depth,
+            fragment,
             bins.strip_items(strip)
                 .iter()
                 .filter_map(|&i| tris.get(i as usize)),
@@ -206,29 +210,31 @@ impl<'s, const S: u32> Frame<'s, S> {
     }
 
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which
-    /// hold exactly those rows (`width * (y1 - y0)` values, row `y0`
-    /// first). Pass `&mut NoDepth` to draw without a depth buffer; depth
-    /// may be a slice or an array of `u16` or `u32`. The buffers are drawn
-    /// over, not cleared.
-    pub fn render_rows<C: PixelFormat, D: DepthBuffer + ?Sized>(
+    /// hold exactly those rows, each covered pixel's interpolated varyings
+    /// turned into its colour by `fragment` (see [`crate::shade`]; coverage
+    /// and depth are the same whatever the shader). Errors and buffers as
+    /// for [`Frame::render_rows`].
+    pub fn render_rows_shaded<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
         y0: u32,
         y1: u32,
         color: &mut [C],
         depth: &mut D,
+        fragment: &F,
     ) -> Result<RenderStats, Error> {
         check_rows(&self.stage.config, y0, y1, color.len(), depth.depth_len())?;
-        Ok(self.draw_each(y0, y1, color, depth, self.triangles().iter()))
+        Ok(self.draw_each(y0, y1, color, depth, fragment, self.triangles().iter()))
     }
 
     /// Draws `tris` into checked rows.
-    fn draw_each<'t, C: PixelFormat, D: DepthBuffer + ?Sized>(
+    fn draw_each<'t, C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
         y0: u32,
         y1: u32,
         color: &mut [C],
         depth: &mut D,
-        tris: impl Iterator<Item = &'t SetupTriangle>,
+        fragment: &F,
+        tris: impl Iterator<Item = &'t SetupTriangle<N>>,
     ) -> RenderStats {
         let c = &self.stage.config;
         let mut strip = Strip {
@@ -242,13 +248,47 @@ impl<'s, const S: u32> Frame<'s, S> {
         };
         let mut stats = RenderStats::default();
         for t in tris {
-            stats.pixels_written += draw::<S, C, D>(t, &mut strip) as u64;
+            stats.pixels_written += draw::<S, N, C, D, F>(t, &mut strip, fragment) as u64;
         }
         stats
     }
 }
 
-impl_submit!(['s, const S: u32] Frame<'s, S>, Store<'s>, store);
+impl<const S: u32> Frame<'_, S, 3> {
+    /// Renders strip `strip` (rows `strip * strip_rows ..`, the last strip
+    /// possibly shorter) of a binned frame into buffers that hold exactly
+    /// those rows, the varyings taken as colours ([`VertexColor`]). The
+    /// same pixels as [`Frame::render_rows`] for those rows.
+    /// [`Error::BinsMismatch`] if `bins` were made for another frame, or
+    /// before triangles were added to this one.
+    pub fn render_strip<C: PixelFormat, D: DepthBuffer + ?Sized>(
+        &self,
+        bins: &Bins<'_>,
+        strip: u32,
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<RenderStats, Error> {
+        self.render_strip_shaded(bins, strip, color, depth, &VertexColor)
+    }
+
+    /// Renders rows `y0..y1` of the frame into `color` and `depth`, which
+    /// hold exactly those rows (`width * (y1 - y0)` values, row `y0`
+    /// first), the varyings taken as colours ([`VertexColor`]). Pass
+    /// `&mut NoDepth` to draw without a depth buffer; depth may be a slice
+    /// or an array of `u16` or `u32`. The buffers are drawn over, not
+    /// cleared.
+    pub fn render_rows<C: PixelFormat, D: DepthBuffer + ?Sized>(
+        &self,
+        y0: u32,
+        y1: u32,
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<RenderStats, Error> {
+        self.render_rows_shaded(y0, y1, color, depth, &VertexColor)
+    }
+}
+
+impl_submit!(['s, const S: u32, const N: usize] Frame<'s, S, N>, Store<'s, N>, store);
 
 #[cfg(test)]
 mod tests {
@@ -347,7 +387,7 @@ mod tests {
         let mesh = Mesh {
             positions: &positions,
             indices: &indices,
-            colors: MeshColors::PerVertex(&colors),
+            attributes: MeshColors::PerVertex(&colors),
             bounds: None,
         };
         for angle in [0.0f32, 0.7, 1.9, 3.0] {

@@ -56,6 +56,7 @@
 //! | settings | `config.rs` | [`Config`], [`CullMode`], [`FrontFace`], the [`Error`]s |
 //! | vertex math | `math.rs` | [`Vec3`], [`Mat4`], the `f32` float backends |
 //! | meshes, vertex stage | `mesh.rs` | [`Mesh`], [`BoundingSphere`] (object cull), [`ProcessedVertex`] (transform, outcode, snap once per vertex) |
+//! | shading | `shade.rs` | [`Attributes`] (varyings per vertex: colours, lighting per vertex, texture coordinates, normals) and [`FragmentShader`] (varyings to colour: [`VertexColor`], textures, lighting per pixel), both chosen at compile time |
 //! | submission | `pipeline.rs` | [`Submit`]: object cull, frustum cull, strip skip, then clip and setup for each triangle |
 //! | clipping | `clip.rs` | outcodes; homogeneous clipping against near, far and the guard band |
 //! | fixed point | `fixed.rs` | snapping to `Sub<S>` window coordinates: where floats end |
@@ -77,6 +78,7 @@
 pub mod config;
 pub mod math;
 pub mod mesh;
+pub mod shade;
 pub mod pipeline;
 pub mod clip;
 pub mod fixed;
@@ -102,6 +104,7 @@ pub use math::{Mat4, Vec3, Vec4};
 pub use mesh::{BoundingSphere, Mesh, MeshColors, ProcessedVertex};
 pub use pipeline::{Submit, MAX_PIECES};
 pub use setup::SetupTriangle;
+pub use shade::{Attributes, FragmentShader, VertexColor};
 pub use stats::{RenderStats, Stats};
 pub use strip_renderer::StripRenderer;
 
@@ -114,6 +117,7 @@ pub mod prelude {
     pub use crate::color::PixelFormat;
     pub use crate::depth::{DepthBuffer, DepthWord};
     pub use crate::pipeline::Submit;
+    pub use crate::shade::{Attributes, FragmentShader};
     pub use embedded_graphics_core::pixelcolor::{
         BinaryColor, Gray8, GrayColor, Rgb565, Rgb888, RgbColor,
     };

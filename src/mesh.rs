@@ -10,6 +10,7 @@
 
 use crate::clip::{outcode, ClipVertex};
 use crate::math::{Mat4, Vec3, Vec4};
+use crate::shade::Attributes;
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
 /// A sphere bounding an object in its own coordinates.
@@ -110,36 +111,39 @@ pub enum MeshColors<'a> {
     PerVertex(&'a [Rgb888]),
 }
 
-/// An indexed triangle mesh in object space.
+/// An indexed triangle mesh in object space, with the source of its
+/// varyings: colours by default ([`MeshColors`]), or any
+/// [`Attributes`](crate::shade::Attributes) (normals and lights, texture
+/// coordinates: see [`crate::shade`]).
 #[derive(Clone, Copy, Debug)]
-pub struct Mesh<'a> {
+pub struct Mesh<'a, A = MeshColors<'a>> {
     /// Vertex positions.
     pub positions: &'a [Vec3],
     /// Triangles as three indices into `positions`.
     pub indices: &'a [[u32; 3]],
-    /// Colours.
-    pub colors: MeshColors<'a>,
+    /// The varyings per vertex (colours by default).
+    pub attributes: A,
     /// A bounding sphere for whole-object culling, if known.
     pub bounds: Option<BoundingSphere>,
 }
 
-impl Mesh<'_> {
-    /// Triangle `i` transformed to clip space by `mvp`, with its colours;
-    /// `None` if an index (or a colour) is out of range.
-    pub fn triangle(&self, i: usize, mvp: &Mat4) -> Option<[ClipVertex; 3]> {
-        let idx = self.indices.get(i)?;
+impl<A> Mesh<'_, A> {
+    /// Triangle `i` transformed to clip space by `mvp`, with its varyings;
+    /// `None` if an index (or an attribute) is out of range.
+    pub fn triangle<const N: usize>(&self, i: usize, mvp: &Mat4) -> Option<[ClipVertex<N>; 3]>
+    where
+        A: Attributes<N>,
+    {
+        let idx = *self.indices.get(i)?;
+        if !self.attributes.has(i, idx) {
+            return None;
+        }
         let mut verts = [ClipVertex::default(); 3];
         for k in 0..3 {
-            let vi = idx[k] as usize;
-            let p = self.positions.get(vi)?;
-            let color = match self.colors {
-                MeshColors::Uniform(c) => c,
-                MeshColors::PerTriangle(cs) => *cs.get(i)?,
-                MeshColors::PerVertex(cs) => *cs.get(vi)?,
-            };
+            let p = self.positions.get(idx[k] as usize)?;
             verts[k] = ClipVertex {
                 pos: mvp.transform_point(*p),
-                color: rgb_f32(color),
+                varyings: self.attributes.get(i, idx[k]),
             };
         }
         Some(verts)

@@ -20,10 +20,10 @@ use crate::clip::{clip_triangle, outcode, ClipVertex};
 use crate::config::Error;
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
-use crate::mesh::{process_vertices, rgb_f32, Mesh, MeshColors, ProcessedVertex, NONFINITE};
+use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
 use crate::setup::{inv_w3, setup, setup_geometry, triangulate, Rejected, SetupTriangle};
+use crate::shade::{Attributes, Varyings};
 use crate::stats::Stats;
-use embedded_graphics_core::pixelcolor::Rgb888;
 
 /// The most set-up pieces one submitted triangle can become (a triangle
 /// clipped by near, far and four guard-band planes is a polygon of at most
@@ -82,14 +82,14 @@ pub mod __private {
         }
     }
 
-    /// Where set-up pieces go.
-    pub trait Sink {
+    /// Where set-up pieces (with `N` varyings) go.
+    pub trait Sink<const N: usize> {
         /// Pieces it can still take (`usize::MAX` for no limit).
         fn room(&self) -> usize;
         /// Its total capacity, for [`Error::StorageFull`](crate::Error).
         fn capacity(&self) -> usize;
         /// Takes one piece; called only while `room() > 0`.
-        fn take(&mut self, t: &SetupTriangle);
+        fn take(&mut self, t: &SetupTriangle<N>);
     }
 
     /// A receiver's parts, borrowed for one submission.
@@ -108,14 +108,14 @@ use __private::{Parts, Sink};
 /// might not fit.
 struct Counter(usize);
 
-impl Sink for Counter {
+impl<const N: usize> Sink<N> for Counter {
     fn room(&self) -> usize {
         usize::MAX
     }
     fn capacity(&self) -> usize {
         usize::MAX
     }
-    fn take(&mut self, _: &SetupTriangle) {
+    fn take(&mut self, _: &SetupTriangle<N>) {
         self.0 = self.0.saturating_add(1);
     }
 }
@@ -124,16 +124,17 @@ impl Sink for Counter {
 /// [`Frame`](crate::Frame), which stores the set-up triangles to render
 /// any rows later, and by [`StripRenderer`](crate::StripRenderer), which
 /// draws them into its strip at once. `S` is the receiver's subpixel
-/// precision.
+/// precision, `N` the number of varyings per vertex (3 by default: a
+/// colour; see [`crate::shade`]).
 ///
 /// Every method is all or nothing: on an error nothing of the submission
 /// is stored, drawn or counted. Triangle ids (see
 /// [`TriangleId`](crate::TriangleId)) are the caller's: a mesh's triangle
 /// `i` gets `first_id + i` (wrapping).
-pub trait Submit<const S: u32 = 8> {
+pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     /// The receiver's sink (internal).
     #[doc(hidden)]
-    type Sink: Sink;
+    type Sink: Sink<N>;
 
     /// The receiver's parts (internal).
     #[doc(hidden)]
@@ -143,22 +144,24 @@ pub trait Submit<const S: u32 = 8> {
     #[doc(hidden)]
     fn stage(&self) -> &Stage;
 
-    /// Submits one clip-space triangle (positions and colours).
-    fn submit_triangle(&mut self, tri: [ClipVertex; 3], id: u32) -> Result<(), Error> {
+    /// Submits one clip-space triangle (positions and varyings).
+    fn submit_triangle(&mut self, tri: [ClipVertex<N>; 3], id: u32) -> Result<(), Error> {
         let job = TriangleJob { tri, id };
-        run_job::<S, _, _>(self.parts(), &job)
+        run_job::<S, N, _, _>(self.parts(), &job)
     }
 
-    /// Submits one clip-space triangle with a colour per vertex.
-    fn submit_clip_triangle(
+    /// Submits one clip-space triangle with varyings per vertex: a colour
+    /// ([`Rgb888`](crate::pixelcolor::Rgb888)) for the default shading,
+    /// or `[f32; N]`.
+    fn submit_clip_triangle<V: Varyings<N>>(
         &mut self,
         pos: [Vec4; 3],
-        color: [Rgb888; 3],
+        varyings: [V; 3],
         id: u32,
     ) -> Result<(), Error> {
         let tri = core::array::from_fn(|k| ClipVertex {
             pos: pos[k],
-            color: rgb_f32(color[k]),
+            varyings: varyings[k].varyings(),
         });
         self.submit_triangle(tri, id)
     }
@@ -167,7 +170,12 @@ pub trait Submit<const S: u32 = 8> {
     /// clip space), one triangle at a time. The bounding sphere, if given,
     /// is tested first: an object entirely outside the frustum is counted
     /// in [`Stats::culled_object`] without transforming a vertex.
-    fn submit_mesh(&mut self, mesh: &Mesh<'_>, mvp: &Mat4, first_id: u32) -> Result<(), Error> {
+    fn submit_mesh<A: Attributes<N>>(
+        &mut self,
+        mesh: &Mesh<'_, A>,
+        mvp: &Mat4,
+        first_id: u32,
+    ) -> Result<(), Error> {
         let n = check_mesh_len(mesh.indices.len())?;
         let mut parts = self.parts();
         if culled_object(&mut parts, mesh, mvp, n) {
@@ -178,16 +186,16 @@ pub trait Submit<const S: u32 = 8> {
             mvp,
             first_id,
         };
-        run_job::<S, _, _>(parts, &job)
+        run_job::<S, N, _, _>(parts, &job)
     }
 
     /// Like [`Submit::submit_mesh`], with every vertex transformed,
     /// outcoded and snapped once instead of once per triangle that uses it:
     /// the fast path for indexed meshes. `cache` is scratch space of at
     /// least `mesh.positions.len()` entries. The result is identical.
-    fn submit_mesh_cached(
+    fn submit_mesh_cached<A: Attributes<N>>(
         &mut self,
-        mesh: &Mesh<'_>,
+        mesh: &Mesh<'_, A>,
         mvp: &Mat4,
         first_id: u32,
         cache: &mut [ProcessedVertex],
@@ -230,9 +238,9 @@ pub trait Submit<const S: u32 = 8> {
     /// (entry `i` for `mesh.positions[i]`; a triangle indexing past the
     /// cache is counted in [`Stats::rejected_index`]; `mesh.bounds` is not
     /// tested here).
-    fn submit_processed_mesh(
+    fn submit_processed_mesh<A: Attributes<N>>(
         &mut self,
-        mesh: &Mesh<'_>,
+        mesh: &Mesh<'_, A>,
         first_id: u32,
         cache: &[ProcessedVertex],
     ) -> Result<(), Error> {
@@ -242,7 +250,7 @@ pub trait Submit<const S: u32 = 8> {
             first_id,
             cache,
         };
-        run_job::<S, _, _>(self.parts(), &job)
+        run_job::<S, N, _, _>(self.parts(), &job)
     }
 }
 
@@ -251,7 +259,7 @@ pub trait Submit<const S: u32 = 8> {
 /// sink_field)`.
 macro_rules! impl_submit {
     ([$($g:tt)*] $ty:ty, $sink:ty, $field:ident) => {
-        impl<$($g)*> $crate::pipeline::Submit<S> for $ty {
+        impl<$($g)*> $crate::pipeline::Submit<S, N> for $ty {
             type Sink = $sink;
 
             fn parts(&mut self) -> $crate::pipeline::__private::Parts<'_, $sink> {
@@ -281,9 +289,9 @@ fn check_mesh_len(n: usize) -> Result<u64, Error> {
 
 /// The bounding-sphere test of a mesh: counts the whole mesh and returns
 /// `true` if it is culled.
-fn culled_object<K: Sink + ?Sized>(
+fn culled_object<K: ?Sized, A>(
     parts: &mut Parts<'_, K>,
-    mesh: &Mesh<'_>,
+    mesh: &Mesh<'_, A>,
     mvp: &Mat4,
     n: u64,
 ) -> bool {
@@ -302,16 +310,21 @@ fn culled_object<K: Sink + ?Sized>(
 
 /// One submission, run once to count (if it might not fit) and once to
 /// deliver.
-trait Job {
+trait Job<const N: usize> {
     /// The most pieces it can yield, found in O(1).
     fn max_pieces(&self) -> usize;
     /// An upper bound on the pieces it yields, at most `max_pieces`.
     fn bound(&self, stage: &Stage) -> usize;
     /// Runs it, counting into `stats` and handing pieces to `sink`.
-    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K);
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    );
 }
 
-fn run_job<const S: u32, K: Sink + ?Sized, J: Job>(
+fn run_job<const S: u32, const N: usize, K: Sink<N> + ?Sized, J: Job<N>>(
     parts: Parts<'_, K>,
     job: &J,
 ) -> Result<(), Error> {
@@ -333,58 +346,98 @@ fn run_job<const S: u32, K: Sink + ?Sized, J: Job>(
     Ok(())
 }
 
-struct TriangleJob {
-    tri: [ClipVertex; 3],
+struct TriangleJob<const N: usize> {
+    tri: [ClipVertex<N>; 3],
     id: u32,
 }
 
-impl Job for TriangleJob {
+impl<const N: usize> Job<N> for TriangleJob<N> {
     fn max_pieces(&self) -> usize {
         MAX_PIECES
     }
     fn bound(&self, _: &Stage) -> usize {
         MAX_PIECES
     }
-    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
         stats.submitted += 1;
-        process::<S, K>(stage, &self.tri, self.id, stats, sink);
+        process::<S, N, K>(stage, &self.tri, self.id, stats, sink);
     }
 }
 
-struct MeshJob<'m> {
-    mesh: &'m Mesh<'m>,
+struct MeshJob<'m, A> {
+    mesh: &'m Mesh<'m, A>,
     mvp: &'m Mat4,
     first_id: u32,
 }
 
-impl Job for MeshJob<'_> {
+impl<const N: usize, A: Attributes<N>> Job<N> for MeshJob<'_, A> {
     fn max_pieces(&self) -> usize {
         self.mesh.indices.len().saturating_mul(MAX_PIECES)
     }
     fn bound(&self, _: &Stage) -> usize {
         self.max_pieces()
     }
-    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
-        for i in 0..self.mesh.indices.len() {
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
+        let mesh = self.mesh;
+        let (gx, gy) = stage.guard;
+        for (i, &idx) in mesh.indices.iter().enumerate() {
             stats.submitted += 1;
-            match self.mesh.triangle(i, self.mvp) {
-                Some(tri) => {
-                    let id = self.first_id.wrapping_add(i as u32);
-                    process::<S, K>(stage, &tri, id, stats, sink);
-                }
-                None => stats.rejected_index += 1,
+            let p = idx.map(|k| mesh.positions.get(k as usize));
+            let (Some(p0), Some(p1), Some(p2)) = (p[0], p[1], p[2]) else {
+                stats.rejected_index += 1;
+                continue;
+            };
+            if !mesh.attributes.has(i, idx) {
+                stats.rejected_index += 1;
+                continue;
             }
+            // Positions first: the varyings (lighting, say) are evaluated
+            // only for triangles that survive the frustum and strip tests.
+            let pos = [p0, p1, p2].map(|q| self.mvp.transform_point(*q));
+            if !pos.iter().all(|v| v.is_finite()) {
+                stats.rejected_nonfinite += 1;
+                continue;
+            }
+            let codes = pos.map(|v| outcode(v, gx, gy));
+            if codes[0] & codes[1] & codes[2] & outcode::FRUSTUM != 0 {
+                stats.culled_frustum += 1;
+                continue;
+            }
+            if stage.outside_strip(pos) {
+                stats.outside_strip += 1;
+                continue;
+            }
+            let tri: [ClipVertex<N>; 3] = core::array::from_fn(|k| ClipVertex {
+                pos: pos[k],
+                varyings: mesh.attributes.get(i, idx[k]),
+            });
+            if !tri.iter().all(|v| v.varyings.iter().all(|c| c.is_finite())) {
+                stats.rejected_nonfinite += 1;
+                continue;
+            }
+            let id = self.first_id.wrapping_add(i as u32);
+            process_finite::<S, N, K>(stage, &tri, codes, id, stats, sink);
         }
     }
 }
 
-struct ProcessedJob<'m> {
-    mesh: &'m Mesh<'m>,
+struct ProcessedJob<'m, A> {
+    mesh: &'m Mesh<'m, A>,
     first_id: u32,
     cache: &'m [ProcessedVertex],
 }
 
-impl Job for ProcessedJob<'_> {
+impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
     fn max_pieces(&self) -> usize {
         self.mesh.indices.len().saturating_mul(MAX_PIECES)
     }
@@ -409,15 +462,17 @@ impl Job for ProcessedJob<'_> {
         })
     }
 
-    fn run<const S: u32, K: Sink + ?Sized>(&self, stage: &Stage, stats: &mut Stats, sink: &mut K) {
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
         let (mesh, cache) = (self.mesh, self.cache);
+        let attrs = &mesh.attributes;
         let c = &stage.config;
-        // Colour lists as long as the mesh need no check per triangle.
-        let colors_complete = match mesh.colors {
-            MeshColors::Uniform(_) => true,
-            MeshColors::PerTriangle(cs) => cs.len() >= mesh.indices.len(),
-            MeshColors::PerVertex(cs) => cs.len() >= cache.len(),
-        };
+        // Attribute lists as long as the mesh need no check per triangle.
+        let complete = attrs.complete(mesh.indices.len(), cache.len());
         for (i, idx) in mesh.indices.iter().enumerate() {
             let id = self.first_id.wrapping_add(i as u32);
             stats.submitted += 1;
@@ -429,26 +484,14 @@ impl Job for ProcessedJob<'_> {
                 stats.rejected_index += 1;
                 continue;
             };
-            // A missing colour counts as a bad index, as in `submit_mesh`.
-            let colors_ok = colors_complete
-                || match mesh.colors {
-                    MeshColors::Uniform(_) => true,
-                    MeshColors::PerTriangle(cs) => i < cs.len(),
-                    MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
-                };
-            if !colors_ok {
+            // A missing attribute counts as a bad index, as in
+            // `submit_mesh`.
+            if !complete && !attrs.has(i, *idx) {
                 stats.rejected_index += 1;
                 continue;
             }
-            let color = |k: usize| -> [f32; 3] {
-                rgb_f32(match mesh.colors {
-                    MeshColors::Uniform(c) => c,
-                    MeshColors::PerTriangle(cs) => cs.get(i).copied().unwrap_or_default(),
-                    MeshColors::PerVertex(cs) => {
-                        cs.get(idx[k] as usize).copied().unwrap_or_default()
-                    }
-                })
-            };
+            // Evaluated only for triangles that survive culling.
+            let var = |k: usize| attrs.get(i, idx[k]);
             let (and, or) = (a.code & b.code & d.code, a.code | b.code | d.code);
             if or & NONFINITE != 0 {
                 stats.rejected_nonfinite += 1;
@@ -472,11 +515,7 @@ impl Job for ProcessedJob<'_> {
                     c.front_face,
                 ) {
                     Ok(g) => {
-                        let t = g.finish(
-                            [a.inv_w, b.inv_w, d.inv_w],
-                            [color(0), color(1), color(2)],
-                            id,
-                        );
+                        let t = g.finish([a.inv_w, b.inv_w, d.inv_w], [var(0), var(1), var(2)], id);
                         sink.take(&t);
                         stats.stored += 1;
                     }
@@ -485,11 +524,11 @@ impl Job for ProcessedJob<'_> {
                 continue;
             }
             let v = [a, b, d];
-            let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
+            let tri: [ClipVertex<N>; 3] = core::array::from_fn(|k| ClipVertex {
                 pos: v[k].pos,
-                color: color(k),
+                varyings: var(k),
             });
-            process_finite::<S, K>(stage, &tri, [a.code, b.code, d.code], id, stats, sink);
+            process_finite::<S, N, K>(stage, &tri, [a.code, b.code, d.code], id, stats, sink);
         }
     }
 }
@@ -505,16 +544,16 @@ fn count_rejected(stats: &mut Stats, r: Rejected) {
 /// Runs one submitted triangle through cull, clip and setup, handing each
 /// set-up piece (at most [`MAX_PIECES`]) to `sink` and counting it in
 /// `stats` (not `submitted`: the caller counts that).
-fn process<const S: u32, K: Sink + ?Sized>(
+fn process<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
     stage: &Stage,
-    tri: &[ClipVertex; 3],
+    tri: &[ClipVertex<N>; 3],
     id: u32,
     stats: &mut Stats,
     sink: &mut K,
 ) {
     if !tri
         .iter()
-        .all(|v| v.pos.is_finite() && v.color.iter().all(|c| c.is_finite()))
+        .all(|v| v.pos.is_finite() && v.varyings.iter().all(|c| c.is_finite()))
     {
         stats.rejected_nonfinite += 1;
         return;
@@ -529,13 +568,13 @@ fn process<const S: u32, K: Sink + ?Sized>(
         stats.outside_strip += 1;
         return;
     }
-    process_finite::<S, K>(stage, tri, codes, id, stats, sink);
+    process_finite::<S, N, K>(stage, tri, codes, id, stats, sink);
 }
 
 /// [`process`] after the finiteness, frustum and strip tests.
-fn process_finite<const S: u32, K: Sink + ?Sized>(
+fn process_finite<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
     stage: &Stage,
-    tri: &[ClipVertex; 3],
+    tri: &[ClipVertex<N>; 3],
     codes: [u16; 3],
     id: u32,
     stats: &mut Stats,
@@ -545,7 +584,7 @@ fn process_finite<const S: u32, K: Sink + ?Sized>(
     let (gx, gy) = stage.guard;
     let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
     if crossing == 0 {
-        match setup::<S>(tri, c.width, c.height, c.cull, c.front_face, id) {
+        match setup::<S, N>(tri, c.width, c.height, c.cull, c.front_face, id) {
             Ok(t) => {
                 sink.take(&t);
                 stats.stored += 1;
@@ -583,7 +622,7 @@ fn process_finite<const S: u32, K: Sink + ?Sized>(
                 let (pa, pb, pd) = (&poly[a], &poly[b], &poly[d]);
                 let t = g.finish(
                     inv_w3([pa.pos.w, pb.pos.w, pd.pos.w]),
-                    [pa.color, pb.color, pd.color],
+                    [pa.varyings, pb.varyings, pd.varyings],
                     id,
                 );
                 sink.take(&t);

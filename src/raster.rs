@@ -35,15 +35,17 @@
 //! strip split (IEEE arithmetic is deterministic, in software on FPU-less
 //! cores too).
 //!
-//! Colour, when it varies, is perspective-correct: `sum(E_k c_k / w_k) /
-//! sum(E_k / w_k)` with the exact edge values converted to `f32` at the
-//! start of each run and the four sums stepped in `f32` along it; one
-//! division per pixel.
+//! Varyings, when they vary, are perspective-correct: `sum(E_k v_k / w_k)
+//! / sum(E_k / w_k)` with the exact edge values converted to `f32` at the
+//! start of each run and the `N + 1` sums stepped in `f32` along it; one
+//! division per pixel, then the fragment shader
+//! ([`FragmentShader`]) makes the colour. A triangle whose vertices carry
+//! equal varyings is shaded once per strip.
 
 use crate::color::PixelFormat;
 use crate::depth::{z32_of, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
-use embedded_graphics_core::pixelcolor::Rgb888;
+use crate::shade::FragmentShader;
 
 /// The integer type edge functions are evaluated in: `i64` always works
 /// (`|E| < 2^59`); `i32` is exact for triangles whose vertices span at most
@@ -128,7 +130,7 @@ pub const EDGE32_SPAN: i64 = 45_000;
 
 /// Whether the triangle's edge values fit `i32` ([`EDGE32_SPAN`]).
 #[inline]
-fn fits_i32(t: &SetupTriangle) -> bool {
+fn fits_i32<const N: usize>(t: &SetupTriangle<N>) -> bool {
     let span = |v: [i32; 3]| v[0].max(v[1]).max(v[2]) as i64 - v[0].min(v[1]).min(v[2]) as i64;
     span(t.x) <= EDGE32_SPAN && span(t.y) <= EDGE32_SPAN
 }
@@ -223,9 +225,21 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
 /// (interleaved runs of the sphere and the bunny).
 const SMALL_WIDTH: u16 = 8;
 
-/// Re-evaluate interpolants from the exact edge values every this many
-/// pixels along a span, so float stepping error stays bounded.
-const RESYNC: i64 = 16;
+/// Re-evaluate varyings from the exact edge values every this many pixels
+/// along a span, so float stepping error stays bounded: every 16 pixels
+/// for a colour (`N <= 3`, error far below one 8-bit step), every pixel
+/// for more varyings (texture coordinates and normals, which need all the
+/// precision `f32` has; stepping them over 16 pixels of a steep
+/// perspective costs 2^-17 of their range, see `tests/shading.rs`).
+const fn resync(n: usize) -> usize {
+    if n <= 3 {
+        16
+    } else {
+        RESYNC_MANY
+    }
+}
+
+const RESYNC_MANY: usize = 1;
 
 /// The float type depth is interpolated in: `f64` for `Z32` buffers,
 /// `f32` where only 16 bits are kept (and on FPU-less or single-precision
@@ -280,7 +294,7 @@ impl_real!(f64);
 impl_real!(f32);
 
 /// Per-triangle constants for shading a covered pixel.
-struct Shader<R> {
+struct Shader<R, const N: usize> {
     /// `Z0`.
     z0: R,
     /// `(Z1 - Z0) / area` and `(Z2 - Z0) / area`.
@@ -292,21 +306,23 @@ struct Shader<R> {
     dz_fixed: i64,
     /// Unbiased edge value = biased value - bias.
     bias: [i64; 3],
-    /// Colour numerators (r, g, b) and denominator change per pixel.
-    dc: [f32; 4],
+    /// Varying numerators' and the denominator's change per pixel.
+    dv: [f32; N],
+    dw: f32,
     smooth: bool,
 }
 
-/// Interpolants at one pixel: depth and colour numerators/denominator.
+/// Interpolants at one pixel: depth, varying numerators, denominator.
 #[derive(Clone, Copy)]
-struct Acc<R> {
+struct Acc<R, const N: usize> {
     z: R,
-    c: [f32; 4],
+    v: [f32; N],
+    w: f32,
 }
 
-impl<R: Real> Shader<R> {
+impl<R: Real, const N: usize> Shader<R, N> {
     fn new<C: PixelFormat, D: DepthBuffer + ?Sized, T: EdgeInt>(
-        t: &SetupTriangle,
+        t: &SetupTriangle<N>,
         edges: &[Edge<T>; 3],
     ) -> Self {
         let (mut k1, mut k2, mut dz) = (R::ZERO, R::ZERO, R::ZERO);
@@ -319,18 +335,19 @@ impl<R: Real> Shader<R> {
                 + k2 * R::from_i64(edges[2].step_x.widen());
         }
         let smooth = C::SHADED && t.smooth;
-        let mut dc = [0.0f32; 4];
+        let mut dv = [0.0f32; N];
+        let mut dw = 0.0f32;
         if smooth {
             let st = [
                 edges[0].step_x.widen() as f32,
                 edges[1].step_x.widen() as f32,
                 edges[2].step_x.widen() as f32,
             ];
-            let cw = &t.color_w;
-            for (c, d) in dc.iter_mut().enumerate().take(3) {
+            let cw = &t.var_w;
+            for (c, d) in dv.iter_mut().enumerate() {
                 *d = st[0] * cw[0][c] + st[1] * cw[1][c] + st[2] * cw[2][c];
             }
-            dc[3] = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
+            dw = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
         }
         Shader {
             z0: R::from_u32(t.z[0]),
@@ -339,7 +356,8 @@ impl<R: Real> Shader<R> {
             dz,
             dz_fixed: dz.to_fixed16(),
             bias: [edges[0].bias, edges[1].bias, edges[2].bias],
-            dc,
+            dv,
+            dw,
             smooth,
         }
     }
@@ -347,7 +365,11 @@ impl<R: Real> Shader<R> {
     /// The interpolants at the pixel whose biased edge values are `e`,
     /// evaluated from the exact edge values.
     #[inline(always)]
-    fn start<D: DepthBuffer + ?Sized, T: EdgeInt>(&self, t: &SetupTriangle, e: [T; 3]) -> Acc<R> {
+    fn start<D: DepthBuffer + ?Sized, T: EdgeInt>(
+        &self,
+        t: &SetupTriangle<N>,
+        e: [T; 3],
+    ) -> Acc<R, N> {
         let z = if D::ENABLED {
             self.z0
                 + self.k1 * e[1].unbiased::<R>(self.bias[1])
@@ -355,44 +377,64 @@ impl<R: Real> Shader<R> {
         } else {
             R::ZERO
         };
-        let mut c = [0.0f32; 4];
+        let mut v = [0.0f32; N];
+        let mut w = 0.0f32;
         if self.smooth {
             let f = [
                 e[0].unbiased_f32(self.bias[0]),
                 e[1].unbiased_f32(self.bias[1]),
                 e[2].unbiased_f32(self.bias[2]),
             ];
-            let cw = &t.color_w;
-            for (ch, v) in c.iter_mut().enumerate().take(3) {
+            let cw = &t.var_w;
+            for (ch, v) in v.iter_mut().enumerate() {
                 *v = f[0] * cw[0][ch] + f[1] * cw[1][ch] + f[2] * cw[2][ch];
             }
-            c[3] = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
+            w = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
         }
-        Acc { z, c }
+        Acc { z, v, w }
+    }
+
+    /// The varyings (not depth) at the pixel whose biased edge values are
+    /// `e`, evaluated from the exact edge values.
+    #[inline(always)]
+    fn resync<T: EdgeInt>(&self, t: &SetupTriangle<N>, e: [T; 3], a: &mut Acc<R, N>) {
+        let f = [
+            e[0].unbiased_f32(self.bias[0]),
+            e[1].unbiased_f32(self.bias[1]),
+            e[2].unbiased_f32(self.bias[2]),
+        ];
+        let cw = &t.var_w;
+        for (ch, v) in a.v.iter_mut().enumerate() {
+            *v = f[0] * cw[0][ch] + f[1] * cw[1][ch] + f[2] * cw[2][ch];
+        }
+        a.w = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
     }
 
     /// Moves the interpolants one pixel to the right.
     #[inline(always)]
-    fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc<R>) {
+    fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc<R, N>) {
         if D::ENABLED {
             a.z = a.z + self.dz;
         }
         if self.smooth {
-            for k in 0..4 {
-                a.c[k] += self.dc[k];
+            for k in 0..N {
+                a.v[k] += self.dv[k];
             }
+            a.w += self.dw;
         }
     }
 
     /// Depth-tests and writes the pixel at `idx` with interpolants `a`.
     /// Returns 1 if written.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn pixel<C: PixelFormat, D: DepthBuffer + ?Sized>(
+    fn pixel<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
-        t: &SetupTriangle,
+        t: &SetupTriangle<N>,
         strip: &mut Strip<'_, C, D>,
+        fragment: &F,
         idx: usize,
-        a: &Acc<R>,
+        a: &Acc<R, N>,
         z32: u32,
         flat: C,
     ) -> u32 {
@@ -404,9 +446,9 @@ impl<R: Real> Shader<R> {
             return 0;
         }
         let value = if self.smooth {
-            let inv = 1.0 / a.c[3];
-            let ch = |c: usize| (a.c[c] * inv + 0.5) as u8;
-            C::from_fragment(Rgb888::new(ch(0), ch(1), ch(2)), t.id)
+            let inv = 1.0 / a.w;
+            let v = a.v.map(|c| c * inv);
+            C::from_fragment(fragment.shade(&v, t.id), t.id)
         } else {
             // Converted once per triangle.
             flat
@@ -423,22 +465,38 @@ impl<R: Real> Shader<R> {
 
 /// Draws one triangle into the strip; returns the number of pixels written.
 #[inline]
-pub(crate) fn draw<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized>(
-    t: &SetupTriangle,
+pub(crate) fn draw<
+    const S: u32,
+    const N: usize,
+    C: PixelFormat,
+    D: DepthBuffer + ?Sized,
+    F: FragmentShader<N>,
+>(
+    t: &SetupTriangle<N>,
     strip: &mut Strip<'_, C, D>,
+    fragment: &F,
 ) -> u32 {
     match (D::WIDE, fits_i32(t)) {
-        (true, true) => draw_in::<S, C, D, f64, i32>(t, strip),
-        (true, false) => draw_in::<S, C, D, f64, i64>(t, strip),
-        (false, true) => draw_in::<S, C, D, f32, i32>(t, strip),
-        (false, false) => draw_in::<S, C, D, f32, i64>(t, strip),
+        (true, true) => draw_in::<S, N, C, D, F, f64, i32>(t, strip, fragment),
+        (true, false) => draw_in::<S, N, C, D, F, f64, i64>(t, strip, fragment),
+        (false, true) => draw_in::<S, N, C, D, F, f32, i32>(t, strip, fragment),
+        (false, false) => draw_in::<S, N, C, D, F, f32, i64>(t, strip, fragment),
     }
 }
 
 /// [`draw`] with depth interpolated in `R` and edge values in `T`.
-fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
-    t: &SetupTriangle,
+fn draw_in<
+    const S: u32,
+    const N: usize,
+    C: PixelFormat,
+    D: DepthBuffer + ?Sized,
+    F: FragmentShader<N>,
+    R: Real,
+    T: EdgeInt,
+>(
+    t: &SetupTriangle<N>,
     strip: &mut Strip<'_, C, D>,
+    fragment: &F,
 ) -> u32 {
     let row_first = (t.min_y as u32).max(strip.y0);
     let row_last = (t.max_y as u32).min(strip.y1.saturating_sub(1));
@@ -455,9 +513,13 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: Ed
         Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
         Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
     ];
-    let shader = Shader::<R>::new::<C, D, T>(t, &edges);
-    // The triangle's flat colour in the output format, once.
-    let flat = C::from_fragment(t.flat, t.id);
+    let shader = Shader::<R, N>::new::<C, D, T>(t, &edges);
+    // A flat triangle's colour in the output format, once per strip.
+    let flat = if shader.smooth {
+        C::from_fragment(t.flat, t.id)
+    } else {
+        C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id)
+    };
     let max_n = (t.max_x - t.min_x) as usize;
     let mut written = 0u32;
     let mut base = (row_first - strip.y0) as usize * strip.width + t.min_x as usize;
@@ -485,7 +547,16 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: Ed
                     if (e[0] | e[1] | e[2]) < T::ZERO {
                         break;
                     }
-                    written += shader.pixel(t, strip, base + k, &acc, acc.z.to_u32(), flat);
+                    // (Never, for colours: their period exceeds the box.)
+                    if resync(N) <= SMALL_WIDTH as usize
+                        && shader.smooth
+                        && (k - n).is_multiple_of(resync(N))
+                        && k != n
+                    {
+                        shader.resync(t, e, &mut acc);
+                    }
+                    written +=
+                        shader.pixel(t, strip, fragment, base + k, &acc, acc.z.to_u32(), flat);
                     e[0] += step[0];
                     e[1] += step[1];
                     e[2] += step[2];
@@ -529,14 +600,14 @@ fn draw_in<const S: u32, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: Ed
             let mut acc = shader.start::<D, T>(t, e);
             // Depth exactly as on a flat span (the same Z32.16 steps from
             // the same start), so the written depth never depends on the
-            // pixel type; colour re-synchronises every RESYNC pixels.
+            // pixel type; varyings re-synchronise every `resync(N)` pixels.
             let mut z = acc.z.to_fixed16();
             let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
             for n in lo..=hi {
-                if (n - lo) % RESYNC as usize == 0 && n != lo {
-                    acc = shader.start::<D, T>(t, e);
+                if (n - lo).is_multiple_of(resync(N)) && n != lo {
+                    shader.resync(t, e, &mut acc);
                 }
-                written += shader.pixel(t, strip, base + n, &acc, z32_of(z), flat);
+                written += shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z), flat);
                 z = z.wrapping_add(shader.dz_fixed);
                 e[0] += edges[0].step_x;
                 e[1] += edges[1].step_x;

@@ -24,12 +24,13 @@ use crate::config::{CullMode, FrontFace};
 use crate::fixed::{snap, SnappedVertex};
 use embedded_graphics_core::pixelcolor::Rgb888;
 
-/// A triangle after setup, ready to rasterize into any rows of its frame.
+/// A triangle after setup, ready to rasterize into any rows of its frame,
+/// with `N` varyings per vertex (3 by default: a colour).
 ///
 /// Frames store these in caller-provided storage (see
 /// [`Frame::new`](crate::Frame::new)); [`SetupTriangle::EMPTY`] fills it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SetupTriangle {
+pub struct SetupTriangle<const N: usize = 3> {
     /// Vertex x in `Sub<S>` units, wound so that `area > 0`.
     pub(crate) x: [i32; 3],
     /// Vertex y in `Sub<S>` units (rows from the top).
@@ -43,21 +44,25 @@ pub struct SetupTriangle {
     pub(crate) max_x: u16,
     pub(crate) min_y: u16,
     pub(crate) max_y: u16,
-    /// For perspective-correct colour: `1 / w_k`, rescaled if extreme.
+    /// For perspective-correct varyings: `1 / w_k`, rescaled if extreme.
     pub(crate) inv_w: [f32; 3],
-    /// Colour times `inv_w`, per vertex.
-    pub(crate) color_w: [[f32; 3]; 3],
-    /// The colour when the triangle is flat (all vertex colours equal).
+    /// Where `smooth`: varyings times `inv_w`, per vertex. Otherwise
+    /// (all three vertices' varyings equal) entry 0 holds the varyings
+    /// themselves.
+    pub(crate) var_w: [[f32; N]; 3],
+    /// Where not `smooth`: the first three varyings rounded to a colour,
+    /// as [`VertexColor`](crate::VertexColor) shades them (once per frame,
+    /// not once per strip; black for `N < 3`).
     pub(crate) flat: Rgb888,
-    /// Whether colour varies over the triangle.
+    /// Whether the varyings vary over the triangle.
     pub(crate) smooth: bool,
     /// The caller's triangle index.
     pub(crate) id: u32,
 }
 
-impl SetupTriangle {
+impl<const N: usize> SetupTriangle<N> {
     /// A placeholder to fill storage with.
-    pub const EMPTY: SetupTriangle = SetupTriangle {
+    pub const EMPTY: SetupTriangle<N> = SetupTriangle {
         x: [0; 3],
         y: [0; 3],
         z: [0; 3],
@@ -67,7 +72,7 @@ impl SetupTriangle {
         min_y: 0,
         max_y: 0,
         inv_w: [0.0; 3],
-        color_w: [[0.0; 3]; 3],
+        var_w: [[0.0; N]; 3],
         flat: Rgb888::new(0, 0, 0),
         smooth: false,
         id: 0,
@@ -99,7 +104,7 @@ impl SetupTriangle {
     }
 }
 
-impl Default for SetupTriangle {
+impl<const N: usize> Default for SetupTriangle<N> {
     fn default() -> Self {
         SetupTriangle::EMPTY
     }
@@ -140,14 +145,14 @@ pub(crate) fn area2(x: [i32; 3], y: [i32; 3]) -> i64 {
 
 /// Sets up one clipped triangle for a `width x height` frame at `S`
 /// subpixel bits.
-pub(crate) fn setup<const S: u32>(
-    v: &[ClipVertex; 3],
+pub(crate) fn setup<const S: u32, const N: usize>(
+    v: &[ClipVertex<N>; 3],
     width: u32,
     height: u32,
     cull: CullMode,
     front: FrontFace,
     id: u32,
-) -> Result<SetupTriangle, Rejected> {
+) -> Result<SetupTriangle<N>, Rejected> {
     let mut s = [SnappedVertex::default(); 3];
     for k in 0..3 {
         let p = v[k].pos;
@@ -159,7 +164,7 @@ pub(crate) fn setup<const S: u32>(
     let g = setup_geometry::<S>(&s, width, height, cull, front)?;
     Ok(g.finish(
         inv_w3([v[0].pos.w, v[1].pos.w, v[2].pos.w]),
-        [v[0].color, v[1].color, v[2].color],
+        [v[0].varyings, v[1].varyings, v[2].varyings],
         id,
     ))
 }
@@ -251,24 +256,31 @@ pub(crate) fn setup_geometry<const S: u32>(
 
 impl Geometry {
     /// Completes setup with the vertices' `1 / w` (all positive) and
-    /// colours, in input order (the winding swap is applied here).
+    /// varyings, in input order (the winding swap is applied here).
     #[inline]
-    pub(crate) fn finish(self, inv_w: [f32; 3], color: [[f32; 3]; 3], id: u32) -> SetupTriangle {
+    pub(crate) fn finish<const N: usize>(
+        self,
+        inv_w: [f32; 3],
+        var: [[f32; N]; 3],
+        id: u32,
+    ) -> SetupTriangle<N> {
         let (iw, c) = if self.swapped {
-            (
-                [inv_w[0], inv_w[2], inv_w[1]],
-                [color[0], color[2], color[1]],
-            )
+            ([inv_w[0], inv_w[2], inv_w[1]], [var[0], var[2], var[1]])
         } else {
-            (inv_w, color)
+            (inv_w, var)
         };
-        // Colour: flat when all three vertex colours are equal.
+        // Flat when all three vertices' varyings are equal.
         let smooth = c[0] != c[1] || c[0] != c[2];
-        let to_u8 = |f: f32| (f + 0.5) as u8;
-        let flat = Rgb888::new(to_u8(c[0][0]), to_u8(c[0][1]), to_u8(c[0][2]));
         let mut inv_w = [1.0f32; 3];
-        let mut color_w = [[0.0f32; 3]; 3];
-        if smooth {
+        let mut var_w = [[0.0f32; N]; 3];
+        let mut flat = Rgb888::new(0, 0, 0);
+        if !smooth {
+            var_w[0] = c[0];
+            if N >= 3 {
+                let to_u8 = |f: f32| (f + 0.5) as u8;
+                flat = Rgb888::new(to_u8(c[0][0]), to_u8(c[0][1]), to_u8(c[0][2]));
+            }
+        } else {
             // Perspective weights `E_k / w_k` only matter in ratio. Within
             // 2^-32..2^32 they are used as they are (products with edge
             // values stay below 2^91, far from f32 overflow); otherwise
@@ -281,8 +293,8 @@ impl Geometry {
                 inv_w = [iw[0] / m, iw[1] / m, iw[2] / m];
             }
             for k in 0..3 {
-                for ch in 0..3 {
-                    color_w[k][ch] = c[k][ch] * inv_w[k];
+                for ch in 0..N {
+                    var_w[k][ch] = c[k][ch] * inv_w[k];
                 }
             }
         }
@@ -296,7 +308,7 @@ impl Geometry {
             min_y: self.bbox[2],
             max_y: self.bbox[3],
             inv_w,
-            color_w,
+            var_w,
             flat,
             smooth,
             id,

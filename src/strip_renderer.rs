@@ -20,15 +20,18 @@ use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
 use crate::raster::{draw, Strip};
 use crate::setup::SetupTriangle;
+use crate::shade::{FragmentShader, VertexColor};
 use crate::stats::{RenderStats, Stats};
 
-/// A strip renderer's sink: its rows, and the pixels written so far.
-pub struct StripSink<'b, C, D: ?Sized, const S: u32> {
+/// A strip renderer's sink: its rows, its fragment shader, and the pixels
+/// written so far.
+pub struct StripSink<'b, C, D: ?Sized, const S: u32, F = VertexColor> {
     strip: Strip<'b, C, D>,
+    fragment: F,
     render: RenderStats,
 }
 
-impl<C, D: ?Sized, const S: u32> core::fmt::Debug for StripSink<'_, C, D, S> {
+impl<C, D: ?Sized, const S: u32, F> core::fmt::Debug for StripSink<'_, C, D, S, F> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("StripSink")
             .field("rows", &(self.strip.y0..self.strip.y1))
@@ -37,7 +40,14 @@ impl<C, D: ?Sized, const S: u32> core::fmt::Debug for StripSink<'_, C, D, S> {
     }
 }
 
-impl<C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Sink for StripSink<'_, C, D, S> {
+impl<
+        C: PixelFormat,
+        D: DepthBuffer + ?Sized,
+        const S: u32,
+        const N: usize,
+        F: FragmentShader<N>,
+    > Sink<N> for StripSink<'_, C, D, S, F>
+{
     fn room(&self) -> usize {
         usize::MAX
     }
@@ -45,14 +55,18 @@ impl<C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Sink for StripSink<'
         usize::MAX
     }
     #[inline]
-    fn take(&mut self, t: &SetupTriangle) {
-        self.render.pixels_written += draw::<S, C, D>(t, &mut self.strip) as u64;
+    fn take(&mut self, t: &SetupTriangle<N>) {
+        self.render.pixels_written +=
+            draw::<S, N, C, D, F>(t, &mut self.strip, &self.fragment) as u64;
     }
 }
 
 /// Draws triangles straight into rows `y0..y1` of a frame, at `S` subpixel
-/// bits, without storing them. Submit with [`Submit`](crate::Submit)'s methods; they
-/// never return [`Error::StorageFull`].
+/// bits, without storing them, with `N` varyings per vertex shaded by `F`
+/// (by default a colour, [`VertexColor`]; see
+/// [`StripRenderer::with_shader`]). Submit with
+/// [`Submit`](crate::Submit)'s methods; they never return
+/// [`Error::StorageFull`].
 ///
 /// ```
 /// use microraster::prelude::*;
@@ -70,13 +84,15 @@ impl<C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> Sink for StripSink<'
 ///     .unwrap();
 /// assert!(strip.render_stats().pixels_written > 0);
 /// ```
-pub struct StripRenderer<'b, C, D: ?Sized, const S: u32 = 8> {
+pub struct StripRenderer<'b, C, D: ?Sized, const S: u32 = 8, const N: usize = 3, F = VertexColor> {
     stage: Stage,
-    sink: StripSink<'b, C, D, S>,
+    sink: StripSink<'b, C, D, S, F>,
     stats: Stats,
 }
 
-impl<C, D: ?Sized, const S: u32> core::fmt::Debug for StripRenderer<'_, C, D, S> {
+impl<C, D: ?Sized, const S: u32, const N: usize, F> core::fmt::Debug
+    for StripRenderer<'_, C, D, S, N, F>
+{
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("StripRenderer")
             .field("config", &self.stage.config)
@@ -111,6 +127,27 @@ impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b
         color: &'b mut [C],
         depth: &'b mut D,
     ) -> Result<Self, Error> {
+        StripRenderer::with_shader(config, y0, y1, color, depth, VertexColor)
+    }
+}
+
+impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32, const N: usize, F>
+    StripRenderer<'b, C, D, S, N, F>
+where
+    F: FragmentShader<N>,
+{
+    /// A renderer like [`StripRenderer::with_subpixel_bits`] whose pixels
+    /// are coloured by the fragment shader `fragment` from `N` varyings
+    /// per vertex (see [`crate::shade`]), e.g.
+    /// `StripRenderer::<_, _, 8, 5, _>::with_shader(.., Textured { texture })`.
+    pub fn with_shader(
+        config: Config,
+        y0: u32,
+        y1: u32,
+        color: &'b mut [C],
+        depth: &'b mut D,
+        fragment: F,
+    ) -> Result<Self, Error> {
         const { check_subpixel_bits::<S>() };
         check_size(&config)?;
         check_rows(&config, y0, y1, color.len(), depth.depth_len())?;
@@ -134,6 +171,7 @@ impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b
                     depth_func: config.depth_func,
                     depth_write: config.depth_write,
                 },
+                fragment,
                 render: RenderStats::default(),
             },
             stats: Stats::default(),
@@ -157,9 +195,9 @@ impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b
 }
 
 impl_submit!(
-    ['b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32]
-    StripRenderer<'b, C, D, S>,
-    StripSink<'b, C, D, S>,
+    ['b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32, const N: usize, F: FragmentShader<N>]
+    StripRenderer<'b, C, D, S, N, F>,
+    StripSink<'b, C, D, S, F>,
     sink
 );
 
@@ -197,7 +235,7 @@ mod tests {
         let mesh = Mesh {
             positions: &positions,
             indices: &indices,
-            colors: MeshColors::PerVertex(&colors),
+            attributes: MeshColors::PerVertex(&colors),
             bounds: None,
         };
         let mut config = Config::new(40, 30);

@@ -742,11 +742,11 @@ proptest! {
         let mut st = storage(1);
         let mut frame = Frame::<8>::new(config_nocull(8, 8), &mut st).unwrap();
         let mut tri = [
-            ClipVertex { pos: Vec4::new(-1.0, -1.0, 0.0, 1.0), color: [1.0; 3] },
-            ClipVertex { pos: Vec4::new(1.0, -1.0, 0.0, 1.0), color: [1.0; 3] },
-            ClipVertex { pos: Vec4::new(0.0, 1.0, 0.0, 1.0), color: [1.0; 3] },
+            ClipVertex { pos: Vec4::new(-1.0, -1.0, 0.0, 1.0), varyings: [1.0; 3] },
+            ClipVertex { pos: Vec4::new(1.0, -1.0, 0.0, 1.0), varyings: [1.0; 3] },
+            ClipVertex { pos: Vec4::new(0.0, 1.0, 0.0, 1.0), varyings: [1.0; 3] },
         ];
-        tri[k].color[ch] = bad;
+        tri[k].varyings[ch] = bad;
         frame.submit_triangle(tri, 0).unwrap();
         prop_assert_eq!(frame.stats().rejected_nonfinite, 1);
         prop_assert_eq!(frame.triangles().len(), 0);
@@ -852,7 +852,7 @@ proptest! {
             1 => MeshColors::PerTriangle(&palette),
             _ => MeshColors::PerVertex(&palette),
         };
-        let mesh = Mesh { positions: &positions, indices: &indices, colors, bounds: None };
+        let mesh = Mesh { positions: &positions, indices: &indices, attributes: colors, bounds: None };
         let mvp = Mat4::perspective(1.0, w as f32 / h as f32, 0.5, 20.0)
             * Mat4::translation(Vec3::new(0.0, 0.0, -dist))
             * Mat4::rotation_y(angle)
@@ -962,7 +962,7 @@ fn draw_mesh_cached_counts_missing_colours_like_draw_mesh() {
     let mesh = Mesh {
         positions: &positions,
         indices: &indices,
-        colors: MeshColors::PerTriangle(&[]),
+        attributes: MeshColors::PerTriangle(&[]),
         bounds: None,
     };
     let (mut s1, mut s2) = (storage(1), storage(1));
@@ -1030,7 +1030,7 @@ proptest! {
         let mut mesh = Mesh {
             positions: &positions,
             indices: &indices,
-            colors: MeshColors::Uniform(Rgb888::new(7, 8, 9)),
+            attributes: MeshColors::Uniform(Rgb888::new(7, 8, 9)),
             bounds: None,
         };
         let draw = |mesh: &Mesh<'_>| {

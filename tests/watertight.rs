@@ -63,7 +63,7 @@ fn check<const S: u32>(positions: &[Vec3], indices: &[[u32; 3]], cameras: usize)
     let mesh = Mesh {
         positions,
         indices,
-        colors: MeshColors::Uniform(Rgb888::new(200, 200, 200)),
+        attributes: MeshColors::Uniform(Rgb888::new(200, 200, 200)),
         bounds: None,
     };
     let (w, h) = (96u32, 80u32);

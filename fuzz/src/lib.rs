@@ -217,7 +217,7 @@ impl Tri {
         let p = self.positions();
         [0, 1, 2].map(|k| ClipVertex {
             pos: p[k],
-            color: self.color[k].map(|c| c as f32),
+            varyings: self.color[k].map(|c| c as f32),
         })
     }
 }
@@ -724,7 +724,7 @@ impl OwnedMesh {
         Mesh {
             positions: &self.positions,
             indices: &self.indices,
-            colors: match self.mode {
+            attributes: match self.mode {
                 0 => MeshColors::Uniform(self.colors.first().copied().unwrap_or(Rgb888::RED)),
                 1 => MeshColors::PerTriangle(&self.colors),
                 _ => MeshColors::PerVertex(&self.colors),

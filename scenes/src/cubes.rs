@@ -188,7 +188,7 @@ pub const TRIANGLE_COLORS: [Rgb888; 12] = {
 pub const MESH: Mesh<'static> = Mesh {
     positions: &POSITIONS,
     indices: &CUBE_INDICES,
-    colors: MeshColors::PerTriangle(&TRIANGLE_COLORS),
+    attributes: MeshColors::PerTriangle(&TRIANGLE_COLORS),
     bounds: Some(BoundingSphere {
         center: Vec3::ZERO,
         radius: 1.7321,

@@ -113,7 +113,7 @@ pub fn fill<const S: u32>(
                 let mut mesh = o.mesh();
                 mesh.indices = &o.indices[r.clone()];
                 if let ObjectColors::PerTriangle(c) = &o.colors {
-                    mesh.colors = MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
+                    mesh.attributes = MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
                 }
                 let id = first_ids[*i].wrapping_add(r.start as u32);
                 match caches.get(*i).copied().flatten() {
@@ -127,7 +127,7 @@ pub fn fill<const S: u32>(
                     let color = [cr as f32, cg as f32, cb as f32];
                     let v = t.v.map(|p| ClipVertex {
                         pos: Vec4::from_array(p),
-                        color,
+                        varyings: color,
                     });
                     frame.submit_triangle(v, clip_first.wrapping_add((r.start + k) as u32))?;
                 }

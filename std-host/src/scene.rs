@@ -58,7 +58,7 @@ impl Object {
         Mesh {
             positions: &self.positions,
             indices: &self.indices,
-            colors: self.colors.as_mesh_colors(),
+            attributes: self.colors.as_mesh_colors(),
             bounds: self.bounds,
         }
     }
@@ -172,7 +172,7 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
     );
     let view_proj = proj * look_at(eye, target)?;
     let mesh = &cubes::MESH;
-    let colors = match mesh.colors {
+    let colors = match mesh.attributes {
         MeshColors::PerTriangle(c) => ObjectColors::PerTriangle(c.to_vec()),
         MeshColors::PerVertex(c) => ObjectColors::PerVertex(c.to_vec()),
         MeshColors::Uniform(c) => ObjectColors::PerTriangle(vec![c; mesh.indices.len()]),

@@ -236,7 +236,7 @@ fn draw_mesh_is_all_or_nothing() {
     let mesh = Mesh {
         positions: &positions,
         indices: &indices,
-        colors: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
+        attributes: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
         bounds: None,
     };
     let mut st = vec![SetupTriangle::EMPTY; 5];

@@ -27,7 +27,7 @@ fn counters_do_not_overflow_past_2_pow_32_triangles() {
     let mesh = Mesh {
         positions: &positions,
         indices: &indices,
-        colors: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
+        attributes: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
         bounds: BoundingSphere::from_points(&positions),
     };
     // Looking down -z from the origin: the mesh at z = +5 is behind.
@@ -121,7 +121,7 @@ fn storage_full_reports_the_true_count_and_writes_no_slot() {
     let mesh = Mesh {
         positions: &positions,
         indices: &indices,
-        colors: MeshColors::Uniform(Rgb888::new(9, 9, 9)),
+        attributes: MeshColors::Uniform(Rgb888::new(9, 9, 9)),
         bounds: None,
     };
     let mut st = [SetupTriangle::EMPTY; 1];
@@ -169,7 +169,7 @@ fn bounding_sphere_keeps_a_tiny_mesh_far_from_the_origin() {
     let mut mesh = Mesh {
         positions: &positions,
         indices: &indices,
-        colors: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
+        attributes: MeshColors::Uniform(Rgb888::new(1, 2, 3)),
         bounds: None,
     };
     let draw = |mesh: &Mesh<'_>| {

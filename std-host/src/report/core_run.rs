@@ -35,7 +35,7 @@ impl CoreObject {
         Mesh {
             positions: &self.positions,
             indices: &self.indices,
-            colors: MeshColors::PerVertex(&self.colors),
+            attributes: MeshColors::PerVertex(&self.colors),
             bounds: self.bounds,
         }
     }
