@@ -10,6 +10,7 @@
 //! | [`scene`] | scenes as plain data, cameras (up-vector choice) |
 //! | [`bench_scenes`] | the built-in scenes (cubes, sphere, bunny, quad) |
 //! | [`obj`] | Wavefront OBJ loading (errors with file and line), framing |
+//! | [`bake`] | `bake`: a model as Rust source for firmware |
 //! | [`cliptris`] | the `--clip-tris` text format |
 //! | [`pipeline`] | setup into binned core frames, threaded strip drawing |
 //! | [`render`] | one image from a scene, counters, checksum |
@@ -24,6 +25,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod bake;
 pub mod bench;
 pub mod bench_scenes;
 pub mod cli;
