@@ -34,8 +34,10 @@
 //! [`ShadedCounts`] and names in a warning; what it cannot (index out of
 //! range, a broken MTL, a missing or bad texture) is an error naming the
 //! file and, where known, the line. Texture and normal indices are checked
-//! before tobj sees them: tobj reports them without a line, and a zero or
-//! too-negative one overflows inside it.
+//! before tobj sees them, by both loaders: tobj reports them without a line,
+//! and a too-negative one overflows inside it (a panic where overflow checks
+//! are on). A file without any `vt` (`vn`) may still name them in faces:
+//! tobj ignores those, and so do the checks.
 //!
 //! [`frame_camera`] places the eye on the `(0, 0.3, 1)` side of the mesh's
 //! bounding sphere at the distance where the sphere (plus a 10% margin) fits
@@ -60,8 +62,12 @@ pub struct LoadedMesh {
 
 /// Loads `path` as a Wavefront OBJ file; all models are merged into one mesh.
 pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
-    let file =
-        File::open(path).map_err(|e| format!("{}: cannot open OBJ file: {e}", path.display()))?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| format!("{}: cannot open OBJ file: {e}", path.display()))?;
+    // Texture and normal indices are unused here, but a bad one can overflow
+    // inside tobj (a panic with overflow checks): refuse it with its line.
+    scan_corners(&String::from_utf8_lossy(&bytes))
+        .map_err(|(line, what)| format!("{}: line {line}: {what}", path.display()))?;
     // `..Default::default()` keeps this compiling if a tobj feature adds fields.
     #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
@@ -72,7 +78,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
         ..Default::default()
     };
     // Materials are not needed: never open the MTL files the OBJ names.
-    let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &options, |_| {
+    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| describe_load_error(path, &e))?;
@@ -486,7 +492,9 @@ fn scan_corners(text: &str) -> Result<CornerScan, (usize, String)> {
                         (2, "normal", seen_vn, total_vn),
                     ];
                     for (slot, name, seen, total) in checks {
-                        let Some(&s) = parts.get(slot).filter(|s| !s.is_empty()) else {
+                        // With no `vt` (`vn`) at all tobj ignores those indices.
+                        let Some(&s) = parts.get(slot).filter(|s| !s.is_empty() && total > 0)
+                        else {
                             continue;
                         };
                         let quoted = format!("`{}`", line.trim());

@@ -383,3 +383,15 @@ fn teapot_and_bunny_get_outward_smooth_normals() {
         check_smooth(&m, name);
     }
 }
+
+#[test]
+fn plain_loader_refuses_bad_uv_indices_without_panicking() {
+    let dir = TempDir::new().unwrap();
+    let obj = write(
+        &dir,
+        "p.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/-5 2/1 3/1\n",
+    );
+    let e = load_obj(&obj).unwrap_err();
+    assert!(e.contains("p.obj") && e.contains("line 5"), "{e}");
+}
