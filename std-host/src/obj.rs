@@ -23,7 +23,8 @@
 //! one index per (v, vt, vn) corner (`single_index`), so normals and UVs are
 //! indexed like positions and a position is duplicated at seams. Without
 //! `vn` it computes smooth normals (area-weighted face normals summed per
-//! position *value*, so UV seams do not crease). UVs are kept as in the file,
+//! position *value*, so UV seams do not crease, with a [`CREASE_ANGLE_DEG`]
+//! limit, so a box keeps its edges). UVs are kept as in the file,
 //! v = 0 at the bottom; textures ([`TextureImage`]) keep the file's row order,
 //! row 0 at the top, so the texel row of v is `(1 - v) * height`. MTL files
 //! and textures are opened relative to the OBJ's folder; textures are PNG
@@ -558,9 +559,21 @@ fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
     None
 }
 
-/// Area-weighted smooth normals, accumulated per position *value* (so
-/// vertices duplicated at UV seams get the same normal), and how many
-/// vertices needed a fallback (their first face's normal, else (0, 0, 1)).
+/// Faces meeting at a larger angle than this keep a hard edge in
+/// [`smooth_normals`] (a box stays a box; a UV seam on a smooth surface,
+/// where the angle is near zero, is smoothed over).
+pub const CREASE_ANGLE_DEG: f32 = 60.0;
+
+/// Area-weighted smooth normals, and how many vertices needed a fallback.
+///
+/// Face normals are accumulated per position *value*, so vertices duplicated
+/// at UV seams get the same normal. Around a position, faces whose normals
+/// are within [`CREASE_ANGLE_DEG`] of each other are linked, transitively,
+/// into smooth sheets; a vertex sums the sheets its own faces are in (so
+/// every copy of a seam vertex on a smooth surface gets the same normal,
+/// and each wall of a box stays flat). A vertex whose sum is zero or non-finite (only
+/// degenerate faces) gets its first non-degenerate face's normal, else
+/// (0, 0, 1), and is counted.
 pub fn smooth_normals(positions: &[[f32; 3]], indices: &[[u32; 3]]) -> (Vec<[f32; 3]>, usize) {
     use std::collections::HashMap;
     let key = |p: [f32; 3]| p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
@@ -572,42 +585,90 @@ pub fn smooth_normals(positions: &[[f32; 3]], indices: &[[u32; 3]]) -> (Vec<[f32
             *slot_of.entry(key(p)).or_insert(next)
         })
         .collect();
-    let mut sums = vec![[0.0f64; 3]; slot_of.len()];
-    let mut face_normal: Vec<Option<[f64; 3]>> = vec![None; positions.len()];
-    for t in indices {
-        let [a, b, c] = t.map(|i| positions[i as usize].map(f64::from));
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        // Twice the area times the unit normal: area weighting for free.
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        if !n.iter().all(|c| c.is_finite()) {
+    let unit = |n: [f64; 3]| {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        (len.is_finite() && len > 0.0).then(|| n.map(|c| c / len))
+    };
+    // Twice the area times the unit normal (area weighting for free), and
+    // the unit normal; `None` for a degenerate or non-finite face.
+    let faces: Vec<Option<([f64; 3], [f64; 3])>> = indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize].map(f64::from));
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            unit(n).map(|nu| (n, nu))
+        })
+        .collect();
+    // Faces around each position value, and each vertex's own faces.
+    let mut at_slot: Vec<Vec<usize>> = vec![Vec::new(); slot_of.len()];
+    let mut own: Vec<Vec<usize>> = vec![Vec::new(); positions.len()];
+    for (f, t) in indices.iter().enumerate() {
+        if faces[f].is_none() {
             continue;
         }
         for &i in t {
-            let s = &mut sums[slots[i as usize]];
-            for k in 0..3 {
-                s[k] += n[k];
+            let s = &mut at_slot[slots[i as usize]];
+            if s.last() != Some(&f) {
+                s.push(f);
             }
-            let f = &mut face_normal[i as usize];
-            if f.is_none() && n.iter().any(|&c| c != 0.0) {
-                *f = Some(n);
-            }
+            own[i as usize].push(f);
         }
     }
-    let unit = |n: [f64; 3]| {
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        (len.is_finite() && len > 0.0).then(|| n.map(|c| (c / len) as f32))
-    };
+    // Around each position, faces whose normals are within the crease angle
+    // are linked, transitively: each group is one smooth sheet.
+    let cos_crease = f64::from(CREASE_ANGLE_DEG).to_radians().cos();
+    let groups: Vec<Vec<usize>> = at_slot
+        .iter()
+        .map(|fs| {
+            let mut parent: Vec<usize> = (0..fs.len()).collect();
+            fn root(p: &mut [usize], mut a: usize) -> usize {
+                while p[a] != a {
+                    p[a] = p[p[a]];
+                    a = p[a];
+                }
+                a
+            }
+            for a in 0..fs.len() {
+                for b in a + 1..fs.len() {
+                    let (_, na) = faces[fs[a]].unwrap_or_default();
+                    let (_, nb) = faces[fs[b]].unwrap_or_default();
+                    if na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2] >= cos_crease {
+                        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                        parent[ra.max(rb)] = ra.min(rb);
+                    }
+                }
+            }
+            (0..fs.len()).map(|a| root(&mut parent, a)).collect()
+        })
+        .collect();
     let mut fallbacks = 0;
     let normals = (0..positions.len())
         .map(|i| {
-            unit(sums[slots[i]]).unwrap_or_else(|| {
+            let (fs, gs) = (&at_slot[slots[i]], &groups[slots[i]]);
+            // The sheets this vertex's own faces belong to.
+            let mine: Vec<usize> = own[i]
+                .iter()
+                .filter_map(|f| fs.iter().position(|g| g == f).map(|k| gs[k]))
+                .collect();
+            let mut sum = [0.0f64; 3];
+            for (&f, g) in fs.iter().zip(gs) {
+                if mine.contains(g) {
+                    let (n, _) = faces[f].unwrap_or_default();
+                    (0..3).for_each(|k| sum[k] += n[k]);
+                }
+            }
+            unit(sum).map(|n| n.map(|c| c as f32)).unwrap_or_else(|| {
                 fallbacks += 1;
-                face_normal[i].and_then(unit).unwrap_or([0.0, 0.0, 1.0])
+                own[i]
+                    .first()
+                    .and_then(|&f| faces[f])
+                    .map_or([0.0, 0.0, 1.0], |(_, nu)| nu.map(|c| c as f32))
             })
         })
         .collect();

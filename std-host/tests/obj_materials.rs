@@ -395,3 +395,42 @@ fn plain_loader_refuses_bad_uv_indices_without_panicking() {
     let e = load_obj(&obj).unwrap_err();
     assert!(e.contains("p.obj") && e.contains("line 5"), "{e}");
 }
+
+#[test]
+fn smooth_normals_keep_hard_edges_and_smooth_seams() {
+    // Cornell box: flat walls (every wall's normal is one axis), not rounded corners.
+    let m = load_obj_shaded(&models().join("CornellBox-Original.obj"), None).unwrap();
+    let floor = m.materials.iter().position(|x| x.name == "floor").unwrap() as u32;
+    for (t, tri) in m.indices.iter().enumerate() {
+        if m.triangle_material[t] == floor {
+            for &i in tri {
+                let n = m.normals[i as usize];
+                assert!(n[1].abs() > 0.999, "floor normal {n:?}");
+            }
+        }
+    }
+    // Two triangles folded by 20 degrees, sharing an edge by value only
+    // (as at a UV seam): the shared corners get one smooth normal.
+    let dir = TempDir::new().unwrap();
+    let z = 20f32.to_radians().sin();
+    let text =
+        format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 {z}\nf 1 2 3\nf 4 6 5\n");
+    let obj = write(&dir, "fold.obj", text.as_bytes());
+    let m = load_obj_shaded(&obj, None).unwrap();
+    let at = |p: [f32; 2]| {
+        m.positions
+            .iter()
+            .enumerate()
+            .filter(move |(_, q)| q[0] == p[0] && q[1] == p[1])
+            .map(|(i, _)| m.normals[i])
+            .collect::<Vec<_>>()
+    };
+    let shared = at([1.0, 0.0]);
+    assert_eq!(shared.len(), 2);
+    assert_eq!(shared[0], shared[1]);
+    let own = at([0.0, 0.0])[0];
+    assert!(
+        own[2] > shared[0][2] && shared[0][2] < 1.0,
+        "{own:?} {shared:?}"
+    );
+}
