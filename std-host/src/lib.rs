@@ -2,8 +2,9 @@
 //!
 //! Design: data flows one way. [`cli`] parses and validates the command
 //! line; the command modules consume what it made and never reach back:
-//! [`render_cmd`] (`render`), [`bench`](mod@bench) (`bench`) and, with the `report`
-//! feature, `report` (`report speed-vs-error`). Below them:
+//! [`render_cmd`] (`render`), [`bench`](mod@bench) (`bench`), [`bake`]
+//! (`bake`) and, with the `report` feature, `report` (`report
+//! speed-vs-error`). Below them:
 //!
 //! | module | what |
 //! |---|---|

@@ -1,10 +1,9 @@
 //! Wavefront OBJ loading and automatic camera framing.
 //!
 //! Design: [`load_obj`] is for the rasterizer alone, which needs only vertex
-//! positions, so the file is read
-//! with `tobj` (faces fan-triangulated, positions indexed on their own, MTL
-//! files never opened) and every model in it is merged into one indexed
-//! mesh. Triangle order is file order after triangulation, model by model, so
+//! positions, so the file is read with `tobj` (faces fan-triangulated,
+//! positions indexed on their own, MTL files never opened) and every model
+//! in it is merged into one indexed mesh. Triangle order is file order after triangulation, model by model, so
 //! triangle ids in the id image can be traced back to the file. Point and line
 //! elements are dropped rather than turned into degenerate triangles. A file
 //! that yields no triangle at all is an error. Bounds are taken over finite
@@ -27,8 +26,8 @@
 //! limit, so a box keeps its edges). UVs are kept as in the file,
 //! v = 0 at the bottom; textures ([`TextureImage`]) keep the file's row order,
 //! row 0 at the top, so the texel row of v is `(1 - v) * height`. MTL files
-//! and textures are opened relative to the OBJ's folder; textures are PNG
-//! only, decoded to 8-bit RGB, at most [`MAX_TEXTURE_SIDE`] pixels a side.
+//! are opened relative to the OBJ's folder, textures beside their MTL file
+//! (`map_Kd` options such as `-s` are skipped); textures are PNG only, decoded to 8-bit RGB, at most [`MAX_TEXTURE_SIDE`] pixels a side.
 //! Triangles without a material get [`Material::default_material`] (light
 //! grey, [`DEFAULT_DIFFUSE`]). What the loader can repair (NaN normals or
 //! UVs, a missing MTL file, degenerate faces) it repairs, counts in
@@ -685,11 +684,30 @@ fn clamp01(c: [f32; 3], default: [f32; 3]) -> [f32; 3] {
     })
 }
 
+/// Where `map_Kd NAME` points: options before the file name (`-s 1 1 1
+/// a.png`, `-clamp on a.png`) are skipped by taking the last word when NAME
+/// starts with `-`; the file is looked for beside its MTL file, then beside
+/// the OBJ (the same folder unless `mtllib` names a subfolder).
+fn texture_path(name: &str, mtl_dir: &Path, obj_dir: &Path) -> std::path::PathBuf {
+    let file = if name.starts_with('-') {
+        name.split_whitespace().last().unwrap_or(name)
+    } else {
+        name
+    };
+    let beside_mtl = mtl_dir.join(file);
+    if beside_mtl.exists() || mtl_dir == obj_dir {
+        beside_mtl
+    } else {
+        obj_dir.join(file)
+    }
+}
+
 /// Loads `path` as a Wavefront OBJ file with normals, texture coordinates and
 /// materials; all models are merged into one mesh (see [`ShadedMesh`]).
 ///
-/// MTL files (`mtllib`) and textures (`map_Kd`) are opened relative to the
-/// OBJ's folder. A missing MTL file is a warning (its materials become the
+/// MTL files (`mtllib`) are opened relative to the OBJ's folder, textures
+/// (`map_Kd`) beside their MTL file (the same folder, unless `mtllib` names a
+/// subfolder; then the OBJ's folder is tried too). A missing MTL file is a warning (its materials become the
 /// default material, counted in [`ShadedCounts::missing_mtl_files`]); a
 /// malformed MTL file, a missing or unreadable texture, a non-PNG texture and
 /// one of zero size or over [`MAX_TEXTURE_SIDE`] are errors. With
@@ -700,6 +718,7 @@ fn clamp01(c: [f32; 3], default: [f32; 3]) -> [f32; 3] {
 /// replaced and counted. Every message names the file.
 pub fn load_obj_shaded(path: &Path, texture_override: Option<&Path>) -> Result<ShadedMesh, String> {
     use std::cell::RefCell;
+    use std::collections::HashMap;
     let bytes = std::fs::read(path)
         .map_err(|e| format!("{}: cannot open OBJ file: {e}", path.display()))?;
     let text = String::from_utf8_lossy(&bytes);
@@ -774,15 +793,20 @@ pub fn load_obj_shaded(path: &Path, texture_override: Option<&Path>) -> Result<S
         mtl_dirs.extend(std::iter::repeat_n(d, n));
     }
     let mut materials: Vec<Material> = Vec::with_capacity(tobj_materials.len() + 1);
+    // Materials sharing a texture file share one decoding.
+    let mut decoded: HashMap<std::path::PathBuf, TextureImage> = HashMap::new();
     for (i, m) in tobj_materials.iter().enumerate() {
         let texture = match (&override_tex, &m.diffuse_texture) {
             (Some(t), _) => Some(t.clone()),
             (None, Some(name)) => {
-                let d = mtl_dirs.get(i).unwrap_or(&dir);
-                let tex_path = d.join(name);
-                Some(load_png_rgb(&tex_path).map_err(|e| {
-                    format!("{}: material {:?}: map_Kd: {e}", path.display(), m.name)
-                })?)
+                let tex_path = texture_path(name, mtl_dirs.get(i).unwrap_or(&dir), &dir);
+                if !decoded.contains_key(&tex_path) {
+                    let t = load_png_rgb(&tex_path).map_err(|e| {
+                        format!("{}: material {:?}: map_Kd: {e}", path.display(), m.name)
+                    })?;
+                    decoded.insert(tex_path.clone(), t);
+                }
+                decoded.get(&tex_path).cloned()
             }
             (None, None) => None,
         };

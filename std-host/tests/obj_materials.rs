@@ -434,3 +434,30 @@ fn smooth_normals_keep_hard_edges_and_smooth_seams() {
         "{own:?} {shared:?}"
     );
 }
+
+#[test]
+fn texture_options_and_subfolders_are_followed() {
+    let dir = TempDir::new().unwrap();
+    std::fs::create_dir(dir.path().join("mats")).unwrap();
+    let obj = write(
+        &dir,
+        "quad.obj",
+        QUAD_UV.replace("m.mtl", "mats/m.mtl").as_bytes(),
+    );
+    // Two materials on one file: beside the MTL, with map_Kd options.
+    write(
+        &dir,
+        "mats/m.mtl",
+        b"newmtl tex\nmap_Kd -s 1 1 1 t.png\nnewmtl other\nmap_Kd t.png\n",
+    );
+    write(&dir, "mats/t.png", &png_bytes(2, 2));
+    let m = load_obj_shaded(&obj, None).unwrap();
+    assert_eq!(m.materials.len(), 2);
+    assert!(m
+        .materials
+        .iter()
+        .all(|x| x.texture.as_ref().is_some_and(|t| t.width == 2)));
+    // Beside the OBJ when not beside the MTL.
+    std::fs::rename(dir.path().join("mats/t.png"), dir.path().join("t.png")).unwrap();
+    assert!(load_obj_shaded(&obj, None).is_ok());
+}
