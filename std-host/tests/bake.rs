@@ -385,3 +385,67 @@ fn bake_help_and_summary() {
     }
     assert!(dir.path().join("spot.rs").is_file());
 }
+
+/// Compiles `baked` with rustc (as a library, warnings denied) next to a
+/// stand-in `microraster::Vec3` with the core's `const fn new`. Returns
+/// false, with a note, where no rustc can be run.
+fn compiles(baked: &Path) -> bool {
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("check.rs");
+    std::fs::write(
+        &lib,
+        format!(
+            "pub mod microraster {{\n\
+             pub struct Vec3 {{ pub x: f32, pub y: f32, pub z: f32 }}\n\
+             impl Vec3 {{ pub const fn new(x: f32, y: f32, z: f32) -> Self {{ Vec3 {{ x, y, z }} }} }}\n\
+             }}\n\
+             pub mod baked {{ use crate::microraster; include!({:?}); }}\n",
+            baked.display().to_string()
+        ),
+    )
+    .unwrap();
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let out = Command::new(rustc)
+        .args([
+            "--edition",
+            "2021",
+            "--crate-type",
+            "lib",
+            "-D",
+            "warnings",
+            "--out-dir",
+        ])
+        .arg(dir.path())
+        .arg(&lib)
+        .output();
+    match out {
+        Err(e) => {
+            eprintln!("note: no rustc to run ({e}): the baked source was not compiled");
+            false
+        }
+        Ok(o) => {
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            true
+        }
+    }
+}
+
+#[test]
+fn baked_source_compiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = BakeOptions {
+        model: models().join("CornellBox-Original.obj"),
+        texture: None,
+        ..spot_opts()
+    };
+    let (_, path) = bake(&cornell, dir.path()).unwrap();
+    compiles(&path);
+    let small_spot = BakeOptions {
+        max_triangles: Some(200),
+        positions: PositionsArg::I16,
+        texture_size: 8,
+        ..spot_opts()
+    };
+    let (_, path) = bake(&small_spot, dir.path()).unwrap();
+    compiles(&path);
+}
