@@ -964,6 +964,14 @@ pub fn load_obj_shaded(path: &Path, texture_override: Option<&Path>) -> Result<S
             warnings.push(format!("{p}: {n} {what}"));
         }
     }
+    // Without any material file, the default material is no surprise.
+    if c.default_material_triangles > 0 && !tobj_materials.is_empty() {
+        warnings.push(format!(
+            "{p}: {} triangles have no `usemtl`, or name a material no MTL file defines: \
+             default material",
+            c.default_material_triangles
+        ));
+    }
 
     let (bounds_min, bounds_max) = finite_bounds(&positions);
     Ok(ShadedMesh {

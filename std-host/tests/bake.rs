@@ -449,3 +449,21 @@ fn baked_source_compiles() {
     let (_, path) = bake(&small_spot, dir.path()).unwrap();
     compiles(&path);
 }
+
+#[test]
+fn bake_errors_are_one_line_with_status_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_microraster"))
+        .args(["bake", "missing.obj", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.starts_with("microraster: error: ") && e.contains("missing.obj"),
+        "{e}"
+    );
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

@@ -461,3 +461,28 @@ fn texture_options_and_subfolders_are_followed() {
     std::fs::rename(dir.path().join("mats/t.png"), dir.path().join("t.png")).unwrap();
     assert!(load_obj_shaded(&obj, None).is_ok());
 }
+
+#[test]
+fn unknown_material_names_get_the_default_with_a_warning() {
+    let (dir, _) = textured_dir("newmtl tex\nKd 1 0 0\n", None);
+    let obj = write(
+        &dir,
+        "two.obj",
+        b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl tex\nf 1 2 3\nusemtl nope\nf 1 3 2\n",
+    );
+    let m = load_obj_shaded(&obj, None).unwrap();
+    assert_eq!(m.materials.len(), 2);
+    assert_eq!(
+        m.materials[m.triangle_material[0] as usize].diffuse,
+        [1.0, 0.0, 0.0]
+    );
+    assert_eq!(
+        m.materials[m.triangle_material[1] as usize].diffuse,
+        DEFAULT_DIFFUSE
+    );
+    assert_eq!(m.counts.default_material_triangles, 1);
+    assert!(m
+        .warnings
+        .iter()
+        .any(|w| w.contains("two.obj") && w.contains("default")));
+}
