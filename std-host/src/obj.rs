@@ -373,7 +373,9 @@ pub struct ShadedMesh {
     /// `true` if every normal came from the file's `vn`.
     pub normals_from_file: bool,
     /// Texture coordinates per vertex, as in the file (v = 0 is the bottom of
-    /// the image, so texel row = (1 - v) * height); `None` without `vt`.
+    /// the image, so texel row = (1 - v) * height; the core's textures are
+    /// addressed row 0 first, so pass it `(u, 1 - v)`, as `bake` writes
+    /// them); `None` without `vt`.
     pub uvs: Option<Vec<[f32; 2]>>,
     /// Materials: the MTL files' in file order, then the default material if
     /// any triangle uses it.

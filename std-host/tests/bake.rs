@@ -101,6 +101,12 @@ fn spot_bakes_with_every_array_sized() {
         "Vec3::new({:?}, {:?}, {:?})",
         first[0], first[1], first[2]
     )));
+    // UVs are flipped into the core's row-0-first convention.
+    let uv = mesh.uvs.as_ref().unwrap()[0];
+    assert!(
+        src.contains(&format!("    [{:?}, {:?}],\n", uv[0], 1.0 - uv[1])),
+        "uv {uv:?}"
+    );
     assert_eq!(report.texture_bytes, 8192);
     assert!(report.total_bytes > report.f32_position_bytes + report.texture_bytes);
     // Only the one file: no temporary left over.
