@@ -18,6 +18,7 @@
 //! | `UVS` (if the model has UVs) | `[[f32; 2]; N]` | `(u, 1 - v)`: v flipped from the file's, so v = 0 is the texture's row 0 (top) |
 //! | `TEXTURE_WIDTH`, `TEXTURE_HEIGHT` (if textured) | `u32` | `--texture-size` |
 //! | `TEXTURE` (if textured) | `[u16; W * H]` | Rgb565 (r5 g6 b5, red in the top bits), row 0 = top of the image |
+//! | `MATERIAL_TEXTURED` (if textured) | `[bool; K]` | which materials sample `TEXTURE` |
 //! | `MATERIAL_DIFFUSE`, `MATERIAL_SPECULAR` | `[[u8; 3]; K]` | `Kd`, `Ks` in 0..=255 |
 //! | `MATERIAL_SHININESS` | `[f32; K]` | `Ns` |
 //! | `TRIANGLE_MATERIAL` | `[u8; M]` | index into the material arrays |
@@ -578,6 +579,18 @@ pub fn bake_source(
         src.push_str("];\n\n");
         texture_bytes = texels.len() * 2;
         total += texture_bytes;
+        let flags: Vec<&str> = mesh
+            .materials
+            .iter()
+            .map(|m| if m.texture.is_some() { "true" } else { "false" })
+            .collect();
+        let _ = writeln!(
+            src,
+            "/// Which materials sample TEXTURE (the others use MATERIAL_DIFFUSE alone).\n\
+             pub static MATERIAL_TEXTURED: [bool; MATERIAL_COUNT] = [{}];\n",
+            flags.join(", ")
+        );
+        total += k;
     }
     let u8c = |c: [f32; 3]| c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8);
     src.push_str("/// Material names, in order:");

@@ -536,8 +536,8 @@ TRIANGLE_COUNT, MATERIAL_COUNT; POSITIONS: [microraster::Vec3; N] (f32, exact) o
 POSITIONS_I16: [[i16; 3]; N] with POSITION_SCALE, POSITION_OFFSET: [f32; 3]
 (position = q * scale + offset); INDICES: [[u32; 3]; M]; NORMALS: [Vec3; N] (unit);
 UVS: [[f32; 2]; N] if the model has UVs, as (u, 1 - v) of the file's, so v = 0 is
-row 0; TEXTURE_WIDTH, TEXTURE_HEIGHT: u32 and TEXTURE: [u16; W*H] (Rgb565, row 0 =
-top of the image, box-filtered) if it has a texture;
+row 0; if it has a texture, TEXTURE_WIDTH, TEXTURE_HEIGHT: u32, TEXTURE: [u16; W*H]
+(Rgb565, row 0 = top of the image, box-filtered) and MATERIAL_TEXTURED: [bool; K];
 MATERIAL_DIFFUSE, MATERIAL_SPECULAR: [[u8; 3]; K], MATERIAL_SHININESS: [f32; K],
 TRIANGLE_MATERIAL: [u8; M]. The MTL and textures are found beside the OBJ; an OBJ
 without an MTL (Spot) takes its texture from --texture. Prints the flash bytes of

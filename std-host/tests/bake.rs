@@ -92,6 +92,7 @@ fn spot_bakes_with_every_array_sized() {
     assert_eq!(konst(&src, "TEXTURE_HEIGHT"), 64);
     assert!(src.contains("pub static TEXTURE: [u16; 4096] = ["));
     assert_eq!(entries(&src, "TEXTURE"), 64 * 64);
+    assert!(src.contains("pub static MATERIAL_TEXTURED: [bool; MATERIAL_COUNT] = [true];"));
     assert!(!src.contains("POSITIONS_I16"));
     assert!(!src.contains("NaN") && !src.contains("inf"));
     // Positions round-trip exactly.
