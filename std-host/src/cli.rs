@@ -55,6 +55,9 @@ pub enum Command {
     /// Write reports, e.g. `report speed-vs-error OUT_DIR` (needs the
     /// `report` feature).
     Report(ReportArgs),
+    /// Bake an OBJ model into Rust source for firmware (`include!`).
+    #[command(after_help = BAKE_HELP)]
+    Bake(BakeArgs),
 }
 
 /// The end of `render --help`: which options each source uses.
@@ -524,6 +527,78 @@ pub fn parse_png_path(s: &str) -> Result<PathBuf, String> {
             "{s}: the triangle-id image is a PNG; use a .png extension"
         )),
     }
+}
+
+/// The end of `bake --help`: what the file holds.
+pub const BAKE_HELP: &str = "\
+Writes DIR/<model>.rs (the OBJ's stem, lower case, [a-z0-9_]): VERTEX_COUNT,
+TRIANGLE_COUNT, MATERIAL_COUNT; POSITIONS: [microraster::Vec3; N] (f32, exact) or
+POSITIONS_I16: [[i16; 3]; N] with POSITION_SCALE, POSITION_OFFSET: [f32; 3]
+(position = q * scale + offset); INDICES: [[u32; 3]; M]; NORMALS: [Vec3; N] (unit);
+UVS: [[f32; 2]; N] if the model has UVs, as (u, 1 - v) of the file's, so v = 0 is
+row 0; if it has a texture, TEXTURE_WIDTH, TEXTURE_HEIGHT: u32, TEXTURE: [u16; W*H]
+(Rgb565, row 0 = top of the image, box-filtered) and MATERIAL_TEXTURED: [bool; K];
+MATERIAL_DIFFUSE, MATERIAL_SPECULAR: [[u8; 3]; K], MATERIAL_SHININESS: [f32; K],
+TRIANGLE_MATERIAL: [u8; M]. The MTL and textures are found beside the OBJ; an OBJ
+without an MTL (Spot) takes its texture from --texture. Prints the flash bytes of
+f32 and i16 positions, the i16 error (max and RMS, relative to the bounding box
+diagonal) and the total. Nothing is written if the bake fails.";
+
+/// Position format of `bake`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PositionsArg {
+    /// `POSITIONS: [microraster::Vec3; N]`, exact.
+    F32,
+    /// `POSITIONS_I16: [[i16; 3]; N]`, quantized over the bounding box.
+    I16,
+}
+
+/// Parses `--texture-size`: a power of two in 1..=1024.
+pub fn parse_texture_size(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if (1..=1024).contains(&n) && n.is_power_of_two() => Ok(n),
+        _ => Err(format!(
+            "texture size must be a power of two from 1 to 1024, got {s:?}"
+        )),
+    }
+}
+
+fn parse_max_triangles(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "max triangles must be a whole number from 1, got {s:?}"
+        )),
+    }
+}
+
+/// Options of `microraster bake`.
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct BakeArgs {
+    /// The Wavefront OBJ model (its MTL files and textures beside it).
+    #[arg(value_name = "MODEL.obj")]
+    pub model: PathBuf,
+
+    /// Folder for `<model>.rs` (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Texture side in texels after resampling (a power of two, 1..=1024).
+    #[arg(long, value_name = "N", default_value = "64", value_parser = parse_texture_size)]
+    pub texture_size: u32,
+
+    /// Position format.
+    #[arg(long, value_enum, default_value_t = PositionsArg::F32)]
+    pub positions: PositionsArg,
+
+    /// Decimate (vertex clustering) to at most N triangles.
+    #[arg(long, value_name = "N", value_parser = parse_max_triangles)]
+    pub max_triangles: Option<u32>,
+
+    /// Use this PNG as the texture of every material (for an OBJ with UVs
+    /// and no MTL, such as Spot).
+    #[arg(long, value_name = "PNG")]
+    pub texture: Option<PathBuf>,
 }
 
 #[cfg(test)]

@@ -2,14 +2,16 @@
 //!
 //! Design: data flows one way. [`cli`] parses and validates the command
 //! line; the command modules consume what it made and never reach back:
-//! [`render_cmd`] (`render`), [`bench`](mod@bench) (`bench`) and, with the `report`
-//! feature, `report` (`report speed-vs-error`). Below them:
+//! [`render_cmd`] (`render`), [`bench`](mod@bench) (`bench`), [`bake`]
+//! (`bake`) and, with the `report` feature, `report` (`report
+//! speed-vs-error`). Below them:
 //!
 //! | module | what |
 //! |---|---|
 //! | [`scene`] | scenes as plain data, cameras (up-vector choice) |
 //! | [`bench_scenes`] | the built-in scenes (cubes, sphere, bunny, quad) |
 //! | [`obj`] | Wavefront OBJ loading (errors with file and line), framing |
+//! | [`bake`] | `bake`: a model as Rust source for firmware |
 //! | [`cliptris`] | the `--clip-tris` text format |
 //! | [`pipeline`] | setup into binned core frames, threaded strip drawing |
 //! | [`render`] | one image from a scene, counters, checksum |
@@ -24,6 +26,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod bake;
 pub mod bench;
 pub mod bench_scenes;
 pub mod cli;

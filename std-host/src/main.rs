@@ -19,6 +19,7 @@ fn main() -> ExitCode {
         Command::Report(args) => microraster_host::report::run(&args),
         #[cfg(not(feature = "report"))]
         Command::Report(_) => Err(microraster_host::NO_REPORT.to_string()),
+        Command::Bake(args) => microraster_host::bake::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
