@@ -65,12 +65,16 @@ pub const RENDER_SOURCES_HELP: &str = "\
 Which options each source uses:
   --scene cubes         --eye, --target, --fov (default: eye 0,3.75,6.5, target 0,0,0, 60°)
   --scene sphere        --eye, --target, --fov (default: eye at the origin looking down -z, 45°)
-  --scene bunny, --scene bunny-subdiv, --obj FILE
+  --scene bunny, --scene bunny-subdiv
                         --eye, --target, --fov (default: framed to fit, 60°)
+  --obj FILE            --eye, --target, --fov (default: framed to fit from +z, 60°), and
+                        --shading, --light, --texture, --no-texture, --texture-filter (default: lit
+                        per pixel by a key light, the .mtl colours and texture)
   --scene quad          no camera: clip-space triangles; --eye, --target, --fov are refused
   --clip-tris FILE      no camera: clip-space triangles; --eye, --target, --fov are refused
 Every source uses --size, --threads, --strip-rows, --cull, --depth, --subpixel and the
-outputs (--out, --id-out, --depth-out, --stats, --checksum). A camera looking straight
+outputs (--out [default: named after the scene or model], --id-out, --depth-out, --stats,
+--checksum). A camera looking straight
 up or down gets -z or +z as its up vector. A render that draws no pixel, or drops
 triangles, says so on stderr with the core's counters.";
 
@@ -100,6 +104,26 @@ pub enum DepthArg {
     U32,
     /// No depth buffer (painter's order).
     None,
+}
+
+/// Lighting of an OBJ model (`render --shading`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingArg {
+    /// One lit colour per triangle (face normals).
+    Flat,
+    /// Lit per vertex (the file's or smooth normals), interpolated.
+    Gouraud,
+    /// Lit per pixel from interpolated normals, with a highlight.
+    Phong,
+}
+
+/// Texture filtering (`render --texture-filter`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FilterArg {
+    /// The nearest texel.
+    Nearest,
+    /// The four nearest texels, weighted.
+    Bilinear,
 }
 
 /// Where the triangles to render come from.
@@ -171,9 +195,34 @@ pub struct RenderArgs {
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
 
-    /// Output image (.png or .ppm).
-    #[arg(long, value_name = "FILE", default_value = "cubes.png", value_parser = parse_image_path)]
-    pub out: PathBuf,
+    /// Output image (.png or .ppm) [default: named after the scene, or the
+    /// OBJ file's stem, e.g. spot.png].
+    #[arg(long, value_name = "FILE", value_parser = parse_image_path)]
+    pub out: Option<PathBuf>,
+
+    /// How an OBJ model is lit: per triangle, per vertex, or per pixel
+    /// with a highlight.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Phong)]
+    pub shading: ShadingArg,
+
+    /// Direction towards the key light in camera space (x right, y up, z
+    /// towards the viewer) [default: -0.4,0.6,1, above left of the viewer].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub light: Option<[f32; 3]>,
+
+    /// Draw an OBJ model without its texture.
+    #[arg(long, conflicts_with = "texture")]
+    pub no_texture: bool,
+
+    /// Texture an OBJ model with this PNG instead of its materials' (a model
+    /// with UVs and no texture named also finds `STEM.png` or
+    /// `STEM_texture.png` beside it).
+    #[arg(long, value_name = "FILE")]
+    pub texture: Option<PathBuf>,
+
+    /// Texture filtering for an OBJ model.
+    #[arg(long, value_enum, default_value_t = FilterArg::Bilinear)]
+    pub texture_filter: FilterArg,
 
     /// Also write the triangle-id image (RGBA PNG).
     #[arg(long, value_name = "FILE", value_parser = parse_png_path)]
@@ -202,6 +251,34 @@ impl RenderArgs {
         } else {
             Source::Scene(self.scene.clone())
         }
+    }
+
+    /// The output image: `--out`, else named after the source
+    /// (`cubes.png`, `spot.png` for `--obj models/spot.obj`,
+    /// `clip-tris.png`).
+    pub fn out_path(&self) -> PathBuf {
+        if let Some(p) = &self.out {
+            return p.clone();
+        }
+        let name = match self.source() {
+            Source::Scene(s) => s,
+            Source::Obj(p) => p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .filter(|s| !s.is_empty())
+                .unwrap_or_else(|| "model".to_string()),
+            Source::ClipTris(_) => "clip-tris".to_string(),
+        };
+        PathBuf::from(format!("{name}.png"))
+    }
+
+    /// Whether any OBJ-only shading option differs from its default.
+    pub fn has_shading_options(&self) -> bool {
+        self.shading != ShadingArg::Phong
+            || self.light.is_some()
+            || self.no_texture
+            || self.texture.is_some()
+            || self.texture_filter != FilterArg::Bilinear
     }
 
     /// Image width in pixels.
@@ -639,7 +716,7 @@ mod tests {
         assert_eq!(r.cull, CullArg::Back);
         assert_eq!(r.depth, DepthArg::U32);
         assert_eq!(r.subpixel, 8);
-        assert_eq!(r.out, PathBuf::from("cubes.png"));
+        assert_eq!(r.out_path(), PathBuf::from("cubes.png"));
         assert_eq!(r.id_out, None);
         assert_eq!(r.depth_out, None);
         assert!(!r.stats && !r.checksum);
@@ -687,7 +764,7 @@ mod tests {
         assert_eq!(r.cull, CullArg::None);
         assert_eq!(r.depth, DepthArg::U16);
         assert_eq!(r.subpixel, 4);
-        assert_eq!(r.out, PathBuf::from("x.PPM"));
+        assert_eq!(r.out_path(), PathBuf::from("x.PPM"));
         assert_eq!(r.id_out, Some("ids.png".into()));
         assert_eq!(r.depth_out, Some("d.raw".into()));
         assert!(r.stats && r.checksum);

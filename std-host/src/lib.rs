@@ -15,6 +15,7 @@
 //! | [`cliptris`] | the `--clip-tris` text format |
 //! | [`pipeline`] | setup into binned core frames, threaded strip drawing |
 //! | [`render`] | one image from a scene, counters, checksum |
+//! | [`shaded`] | one lit, textured model (`render --obj`): the core's shading types |
 //! | [`output`] | every output staged in a temporary file, then renamed |
 //! | [`image_out`] | PNG / PPM / raw encoders |
 //!
@@ -40,6 +41,7 @@ pub mod render_cmd;
 #[cfg(feature = "report")]
 pub mod report;
 pub mod scene;
+pub mod shaded;
 
 /// The default scene's data, from the shared no_std scenes crate.
 pub use microraster_scenes::cubes;

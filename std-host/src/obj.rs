@@ -41,7 +41,9 @@
 //!
 //! [`frame_camera`] places the eye on the `(0, 0.3, 1)` side of the mesh's
 //! bounding sphere at the distance where the sphere (plus a 10% margin) fits
-//! both the vertical and the horizontal field of view.
+//! both the vertical and the horizontal field of view (the benchmarks'
+//! camera); [`frame_camera_front`], `render --obj`'s, on the model's front
+//! ([`front_direction`]: -z, unless the model opens towards +z).
 
 use std::fs::File;
 use std::io::BufReader;
@@ -241,6 +243,59 @@ pub const FRAME_MARGIN: f32 = 1.1;
 /// rejected: the field of view to 1°..=179°, a non-finite or non-positive
 /// aspect to 1, a zero-size mesh to radius 1.
 pub fn frame_camera(mesh: &LoadedMesh, fov_y_deg: f32, aspect: f32) -> ([f32; 3], [f32; 3]) {
+    frame_camera_from(mesh, FRAME_DIRECTION, fov_y_deg, aspect)
+}
+
+/// The side a model is seen from by `render --obj`: its front.
+///
+/// Many OBJ models face -z (Spot does), so the eye goes on the `(0, 0.3,
+/// -1)` side, looking towards +z, unless the model is open towards +z: a
+/// room or a box seen from inside, like the Cornell box, whose inward
+/// walls face away from an eye at -z. That is decided by the projected
+/// area of the faces an eye on each side sees (the sum over triangles of
+/// the area-weighted normal's `-z` or `+z` part): for a closed mesh the two
+/// are equal (the normals of a closed surface sum to zero), and the
+/// convention holds; +z is taken only where it sees over 10 % more.
+pub fn front_direction(mesh: &LoadedMesh) -> [f32; 3] {
+    let (mut towards_minus, mut towards_plus) = (0.0f64, 0.0f64);
+    for t in &mesh.indices {
+        let p = |k: usize| {
+            mesh.positions
+                .get(t[k] as usize)
+                .map(|v| v.map(f64::from))
+                .filter(|v| v.iter().all(|c| c.is_finite()))
+        };
+        let (Some(a), Some(b), Some(c)) = (p(0), p(1), p(2)) else {
+            continue;
+        };
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+        let nz = u[0] * v[1] - u[1] * v[0];
+        if nz < 0.0 {
+            towards_minus -= nz;
+        } else {
+            towards_plus += nz;
+        }
+    }
+    if towards_plus > 1.1 * towards_minus {
+        [0.0, 0.3, 1.0]
+    } else {
+        [0.0, 0.3, -1.0]
+    }
+}
+
+/// [`frame_camera`] from the model's front ([`front_direction`]): the
+/// camera of `render --obj`.
+pub fn frame_camera_front(mesh: &LoadedMesh, fov_y_deg: f32, aspect: f32) -> ([f32; 3], [f32; 3]) {
+    frame_camera_from(mesh, front_direction(mesh), fov_y_deg, aspect)
+}
+
+/// [`frame_camera`] with the eye towards `direction` from the centre.
+fn frame_camera_from(
+    mesh: &LoadedMesh,
+    direction: [f32; 3],
+    fov_y_deg: f32,
+    aspect: f32,
+) -> ([f32; 3], [f32; 3]) {
     let fov = if fov_y_deg.is_finite() {
         fov_y_deg.clamp(1.0, 179.0)
     } else {
@@ -270,7 +325,7 @@ pub fn frame_camera(mesh: &LoadedMesh, fov_y_deg: f32, aspect: f32) -> ([f32; 3]
     let half_v = (fov as f64).to_radians() * 0.5;
     let half_h = (half_v.tan() * aspect as f64).atan();
     let distance = radius * FRAME_MARGIN as f64 / half_v.min(half_h).sin();
-    let dir = FRAME_DIRECTION.map(f64::from);
+    let dir = direction.map(f64::from);
     let len = dir.iter().map(|c| c * c).sum::<f64>().sqrt();
     let eye = [0, 1, 2].map(|k| (centre[k] + dir[k] / len * distance) as f32);
     let target = centre.map(|c| c as f32);

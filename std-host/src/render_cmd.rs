@@ -14,14 +14,17 @@
 //! to stderr.
 
 use crate::bench_scenes;
-use crate::cli::{CullArg, DepthArg, RenderArgs, Source};
+use crate::cli::{CullArg, DepthArg, FilterArg, RenderArgs, ShadingArg, Source};
 use crate::cliptris;
 use crate::image_out;
 use crate::obj;
 use crate::output::{self, Output, Payload};
 use crate::render::{self, Counters, DepthKind, RenderOptions, Rendered, Timings};
 use crate::scene::{self, Scene, View};
-use microraster::CullMode;
+use crate::shaded::{self, Camera, ShadedModel, ShadingMode, ShadingOptions, TextureData};
+use microraster::pixelcolor::Rgb888;
+use microraster::shade::Material;
+use microraster::{CullMode, Vec3};
 use serde::Serialize;
 use std::path::Path;
 
@@ -110,15 +113,171 @@ pub fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
     }
 }
 
+/// The OBJ model at `path`, lit and textured as its file says (see
+/// [`shaded`]), with the loader's warnings.
+pub fn load_model(
+    path: &Path,
+    texture: Option<&Path>,
+) -> Result<(ShadedModel, obj::ShadedMesh, Vec<String>), String> {
+    let mesh = obj::load_obj_shaded(path, texture)?;
+    let mut notes = Vec::new();
+    // A model with UVs and no texture named anywhere: a PNG beside it
+    // named after it (`spot.obj`: `spot.png` or `spot_texture.png`).
+    let mut beside = None;
+    if texture.is_none() && mesh.uvs.is_some() && mesh.materials.iter().all(|m| m.texture.is_none())
+    {
+        if let Some(t) = beside_texture(path) {
+            let image = obj::load_png_rgb(&t)?;
+            notes.push(format!(
+                "{}: its material names no texture; using {} (found beside it by name)",
+                path.display(),
+                t.display()
+            ));
+            beside = Some(image);
+        }
+    }
+    let v = Vec3::from_array;
+    let to_rgb = |c: [f32; 3]| {
+        let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+        Rgb888::new(q(c[0]), q(c[1]), q(c[2]))
+    };
+    let material_of = |t: usize| {
+        mesh.triangle_material
+            .get(t)
+            .and_then(|&m| mesh.materials.get(m as usize))
+    };
+    // A texture: the first material's that has one (one texture per
+    // model; textured triangles of other materials use it too).
+    let texture = mesh
+        .materials
+        .iter()
+        .find_map(|m| m.texture.as_ref())
+        .or(beside.as_ref())
+        .map(|t| TextureData {
+            width: t.width,
+            height: t.height,
+            texels: t
+                .rgb
+                .iter()
+                .map(|c| Rgb888::new(c[0], c[1], c[2]))
+                .collect(),
+        });
+    // Textured materials show the texture as it is (Kd is a tint).
+    let diffuse = (0..mesh.indices.len())
+        .map(|t| material_of(t).map_or(Rgb888::new(204, 204, 204), |m| to_rgb(m.diffuse)))
+        .collect();
+    // One highlight for the model: the strongest material's, or a soft
+    // default for files without an MTL.
+    let material = match mesh
+        .materials
+        .iter()
+        .filter(|m| m.specular.iter().any(|&c| c > 0.0))
+        .max_by(|a, b| a.specular[0].total_cmp(&b.specular[0]))
+    {
+        Some(m) => Material {
+            specular: m.specular,
+            shininess: m.shininess.round().clamp(1.0, 1024.0) as u16,
+        },
+        None if mesh
+            .materials
+            .iter()
+            .all(|m| m.name == obj::DEFAULT_MATERIAL_NAME) =>
+        {
+            Material {
+                specular: DEFAULT_SPECULAR,
+                shininess: DEFAULT_SHININESS,
+            }
+        }
+        None => Material::MATTE,
+    };
+    let model = ShadedModel {
+        positions: mesh.positions.iter().map(|&p| v(p)).collect(),
+        indices: mesh.indices.clone(),
+        normals: mesh.normals.iter().map(|&n| v(n)).collect(),
+        // The file's v points up; the core's row 0 is the texture's top.
+        uvs: mesh
+            .uvs
+            .as_ref()
+            .map(|uv| uv.iter().map(|t| [t[0], 1.0 - t[1]]).collect()),
+        diffuse,
+        texture,
+        material,
+    };
+    Ok((model, mesh, notes))
+}
+
+/// `DIR/STEM.png` or `DIR/STEM_texture.png` beside the OBJ file, if one
+/// exists.
+fn beside_texture(obj: &Path) -> Option<std::path::PathBuf> {
+    let stem = obj.file_stem()?.to_string_lossy().into_owned();
+    let dir = obj.parent().unwrap_or(Path::new(""));
+    [format!("{stem}.png"), format!("{stem}_texture.png")]
+        .into_iter()
+        .map(|n| dir.join(n))
+        .find(|p| p.is_file())
+}
+
+/// The highlight of a model without an MTL file.
+pub const DEFAULT_SPECULAR: [f32; 3] = [0.25; 3];
+
+/// Its exponent.
+pub const DEFAULT_SHININESS: u16 = 32;
+
+/// Renders the OBJ model at `path`; returns the render and the loader's
+/// warnings.
+fn render_obj(
+    args: &RenderArgs,
+    path: &Path,
+    opts: &RenderOptions,
+) -> Result<(Rendered, Vec<String>), String> {
+    let (model, mesh, notes) = load_model(path, args.texture.as_deref())?;
+    for n in &notes {
+        eprintln!("microraster: {n}");
+    }
+    let fov = args.fov.unwrap_or(60.0);
+    let (eye, target) = match (args.eye, args.target) {
+        (Some(e), Some(t)) => (e, t),
+        (e, t) => {
+            let (fe, ft) = obj::frame_camera_front(&mesh.to_loaded(), fov, args.aspect());
+            (e.unwrap_or(fe), t.unwrap_or(ft))
+        }
+    };
+    let camera = Camera {
+        eye,
+        target,
+        fov_y_deg: fov,
+    };
+    let shading = ShadingOptions {
+        mode: match args.shading {
+            ShadingArg::Flat => ShadingMode::Flat,
+            ShadingArg::Gouraud => ShadingMode::Gouraud,
+            ShadingArg::Phong => ShadingMode::Phong,
+        },
+        light: args.light.unwrap_or(shaded::DEFAULT_LIGHT),
+        texture: !args.no_texture,
+        bilinear: args.texture_filter == FilterArg::Bilinear,
+    };
+    let r = shaded::render_shaded(&model, &camera, opts, &shading)?;
+    Ok((r, mesh.warnings))
+}
+
 /// Checks what can be checked before rendering.
-fn check_args(args: &RenderArgs) -> Result<(), String> {
-    image_out::image_format(&args.out)?;
+fn check_args(args: &RenderArgs, out: &Path) -> Result<(), String> {
+    image_out::image_format(out)?;
+    if args.has_shading_options() && !matches!(args.source(), Source::Obj(_)) {
+        return Err(
+            "--shading, --light, --texture, --no-texture and --texture-filter apply to \
+                    --obj models only (the built-in scenes and --clip-tris carry \
+                    their own colours)"
+                .to_string(),
+        );
+    }
     if args.depth == DepthArg::None && args.depth_out.is_some() {
         return Err("--depth-out needs a depth buffer, but --depth is none: \
                     use --depth u16 or u32, or drop --depth-out"
             .to_string());
     }
-    let mut paths: Vec<(&str, &Path)> = vec![("--out", &args.out)];
+    let mut paths: Vec<(&str, &Path)> = vec![("--out", out)];
     if let Some(p) = &args.id_out {
         paths.push(("--id-out", p));
     }
@@ -180,8 +339,8 @@ pub fn warnings(r: &Rendered) -> Vec<String> {
 
 /// Runs `microraster render`.
 pub fn run(args: &RenderArgs) -> Result<(), String> {
-    check_args(args)?;
-    let scene = load_scene(args)?;
+    let out = args.out_path();
+    check_args(args, &out)?;
     let opts = RenderOptions {
         width: args.width(),
         height: args.height(),
@@ -200,7 +359,10 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         strip_rows: args.strip_rows,
         ids: args.id_out.is_some(),
     };
-    let r = render::render(&scene, &opts)?;
+    let (r, load_warnings) = match args.source() {
+        Source::Obj(path) => render_obj(args, &path, &opts)?,
+        _ => (render::render(&load_scene(args)?, &opts)?, Vec::new()),
+    };
 
     let ids_rgba: Option<Vec<u8>> = r
         .ids
@@ -209,9 +371,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let depth_bytes = r.depth.to_le_bytes();
     let mut outputs = vec![Output {
         option: "--out",
-        path: &args.out,
+        path: &out,
         payload: Payload::Rgb {
-            format: image_out::image_format(&args.out)?,
+            format: image_out::image_format(&out)?,
             width: r.width,
             height: r.height,
             data: &r.rgb,
@@ -237,7 +399,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     }
     output::write_all(&outputs)?;
 
-    for w in warnings(&r) {
+    for w in load_warnings.iter().chain(&warnings(&r)) {
         eprintln!("microraster: warning: {w}");
     }
     let checksum = format!("{:016x}", r.checksum());
@@ -266,7 +428,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .collect();
     eprintln!(
         "microraster: wrote {} ({}x{}, {} triangles, {} pixels{also})",
-        args.out.display(),
+        out.display(),
         r.width,
         r.height,
         r.stats.submitted,
