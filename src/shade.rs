@@ -475,6 +475,20 @@ impl Texel for Rgb565 {
     }
 }
 
+impl Texel for u16 {
+    /// An `Rgb565` word (red in the top five bits), as displays and baked
+    /// textures (`microraster bake`) store it; widened like [`Rgb565`].
+    #[inline(always)]
+    fn rgb(self) -> [f32; 3] {
+        let (r, g, b) = ((self >> 11) as u32, ((self >> 5) & 63) as u32, (self & 31) as u32);
+        [
+            ((r << 3) | (r >> 2)) as f32,
+            ((g << 2) | (g >> 4)) as f32,
+            ((b << 3) | (b >> 2)) as f32,
+        ]
+    }
+}
+
 /// How texture coordinates outside `0..1` are treated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Wrap {
@@ -732,6 +746,19 @@ mod tests {
         assert_eq!(tex.sample(0.5, 0.5), [50.0, 50.0, 50.0]);
         // At a texel centre: that texel.
         assert_eq!(tex.sample(0.75, 0.25), [200.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn rgb565_words_sample_like_rgb565() {
+        for c in [
+            Rgb565::new(31, 0, 0),
+            Rgb565::new(0, 63, 0),
+            Rgb565::new(3, 40, 17),
+        ] {
+            use embedded_graphics_core::pixelcolor::raw::ToBytes;
+            let word = u16::from_be_bytes(c.to_be_bytes());
+            assert_eq!(word.rgb(), c.rgb());
+        }
     }
 
     #[test]
