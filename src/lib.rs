@@ -130,3 +130,8 @@ pub use embedded_graphics_core::pixelcolor;
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+/// The shading guide's code examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/shading.md")]
+struct ShadingDoctests;
