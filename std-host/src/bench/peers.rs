@@ -256,7 +256,7 @@ pub fn project_2d(scene: &Scene, width: u32, height: u32, cull: CullMode) -> Vec
             if iarea == 0 {
                 continue;
             }
-            let c = v[0].color;
+            let c = v[0].varyings;
             let color = Rgb565::from(Rgb888::new(c[0] as u8, c[1] as u8, c[2] as u8));
             out.push(Tri2d { p: px, color });
         }

@@ -171,7 +171,107 @@ fn peers_of<const S: u32, C: BenchColor, T: DepthWord>(
         None => run_frames::<S, C, T>(bs, s, depth_on, 1, false, "peers: 1 thread", progress)?,
     };
     progress.note("peers");
-    Ok(Some(super::peers::peers_section::<S, C>(bs, s, &mr)?))
+    let mut o = super::peers::peers_section::<S, C>(bs, s, &mr)?;
+    o["tgx_host"] = tgx_host_section::<S, C, T>(bs, s, depth_on, progress)?;
+    Ok(Some(o))
+}
+
+/// Rounds of the side-by-side run against tgx (`../shared/peers/tgx-host`).
+#[cfg(feature = "peers")]
+pub const TGX_ROUNDS: usize = 3;
+
+/// The tgx sphere harness, if it is beside the checkout: `MICRORASTER_PEERS`
+/// or `../shared/peers` from the repository root.
+#[cfg(feature = "peers")]
+pub fn tgx_host_script() -> Option<std::path::PathBuf> {
+    let dir = match std::env::var_os("MICRORASTER_PEERS") {
+        Some(d) => std::path::PathBuf::from(d),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/peers"),
+    };
+    let script = dir.join("tgx-host/run.sh");
+    script.is_file().then_some(script)
+}
+
+/// `median Y ms` from the tgx harness's summary line.
+#[cfg(feature = "peers")]
+pub fn parse_tgx_median(out: &str) -> Option<f64> {
+    out.lines().find_map(|l| {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        let i = w.iter().position(|&t| t == "median")?;
+        w.get(i + 1)?.parse().ok()
+    })
+}
+
+/// tgx on the same sphere, side by side: [`TGX_ROUNDS`] rounds, each one
+/// microraster run (1 thread, this benchmark's settings) then one tgx run
+/// of as many frames (A B A B ...); the ratio is of the medians of the
+/// rounds' medians, from this one invocation. Skipped (with the reason)
+/// for other scenes or when the harness is absent.
+#[cfg(feature = "peers")]
+fn tgx_host_section<const S: u32, C: BenchColor, T: DepthWord>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    depth_on: bool,
+    progress: &mut Progress,
+) -> Result<Value, String> {
+    use serde_json::json;
+    if bs.name != "sphere" {
+        return Ok(json!(
+            "skipped: the tgx harness draws the sphere scene only"
+        ));
+    }
+    let Some(script) = tgx_host_script() else {
+        return Ok(json!(
+            "skipped: ../shared/peers/tgx-host not found (set MICRORASTER_PEERS to its folder)"
+        ));
+    };
+    let (mut ours, mut tgx) = (Vec::new(), Vec::new());
+    for round in 0..TGX_ROUNDS {
+        let what = format!(
+            "tgx side by side, round {}/{TGX_ROUNDS}: microraster",
+            round + 1
+        );
+        let r = run_frames::<S, C, T>(bs, s, depth_on, 1, false, &what, progress)?;
+        ours.push(median(&r.total));
+        progress.note(&format!(
+            "tgx side by side, round {}/{TGX_ROUNDS}: tgx",
+            round + 1
+        ));
+        let out = std::process::Command::new("sh")
+            .arg(&script)
+            .args(["--frames", &s.frames.to_string()])
+            .args(["--warmup", &s.warmup.to_string()])
+            .args(["--spin", &s.spin.to_string()])
+            .output()
+            .map_err(|e| format!("{}: {e}", script.display()))?;
+        let text = String::from_utf8_lossy(&out.stdout);
+        if !out.status.success() {
+            return Ok(json!(format!(
+                "skipped: {} failed: {}",
+                script.display(),
+                String::from_utf8_lossy(&out.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("")
+            )));
+        }
+        match parse_tgx_median(&text) {
+            Some(m) => tgx.push(m),
+            None => return Err(format!("{}: no median in its output", script.display())),
+        }
+    }
+    let (mo, mt) = (median(&ours), median(&tgx));
+    Ok(json!({
+        "script": script.display().to_string(),
+        "rounds": TGX_ROUNDS,
+        "microraster_median_ms": ours,
+        "tgx_median_ms": tgx,
+        "microraster_over_tgx": mo / mt,
+        "method": "interleaved rounds (microraster 1 thread, then tgx's harness, same \
+             frame count, warm-up and spin); each round's median; the ratio is of the \
+             medians of those, all from this one run. tgx clears and draws a Gouraud-lit \
+             sphere (it also lights every vertex); ours draws the sphere scene as configured.",
+    }))
 }
 
 /// Times `s.warmup + s.frames` frames at `threads` threads.
@@ -277,4 +377,17 @@ fn render_fn_section(
     o["color"] = json!("rgb888");
     o["checksum"] = json!(format!("{checksum:016x}"));
     Ok(o)
+}
+
+#[cfg(all(test, feature = "peers"))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tgx_summary_line_is_parsed() {
+        let out = "# covered 12345 px\nmean 0.951 ms median 0.9295 ms best 0.88 ms\nmax 1.2 ms\n";
+        assert_eq!(parse_tgx_median(out), Some(0.9295));
+        assert_eq!(parse_tgx_median("no numbers here"), None);
+        assert_eq!(parse_tgx_median("median x ms"), None);
+    }
 }
