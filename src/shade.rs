@@ -480,7 +480,11 @@ impl Texel for u16 {
     /// textures (`microraster bake`) store it; widened like [`Rgb565`].
     #[inline(always)]
     fn rgb(self) -> [f32; 3] {
-        let (r, g, b) = ((self >> 11) as u32, ((self >> 5) & 63) as u32, (self & 31) as u32);
+        let (r, g, b) = (
+            (self >> 11) as u32,
+            ((self >> 5) & 63) as u32,
+            (self & 31) as u32,
+        );
         [
             ((r << 3) | (r >> 2)) as f32,
             ((g << 2) | (g >> 4)) as f32,
