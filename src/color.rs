@@ -38,7 +38,8 @@ impl PixelFormat for Rgb565 {
     /// multiplication per channel.
     #[inline]
     fn from_fragment(rgb: Rgb888, _: u32) -> Self {
-        let word = RGB565_R[rgb.r() as usize] | RGB565_G[rgb.g() as usize] | RGB565_B[rgb.b() as usize];
+        let word =
+            RGB565_R[rgb.r() as usize] | RGB565_G[rgb.g() as usize] | RGB565_B[rgb.b() as usize];
         Rgb565::from(RawU16::new(word))
     }
 }

@@ -421,7 +421,7 @@ impl<const N: usize, A: Attributes<N>> Job<N> for MeshJob<'_, A> {
                 pos: pos[k],
                 varyings: mesh.attributes.get(i, idx[k]),
             });
-            if !tri.iter().all(|v| v.varyings.iter().all(|c| c.is_finite())) {
+            if !A::FINITE && !tri.iter().all(|v| v.varyings.iter().all(|c| c.is_finite())) {
                 stats.rejected_nonfinite += 1;
                 continue;
             }
@@ -505,6 +505,20 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
                 stats.outside_strip += 1;
                 continue;
             }
+            // Varyings that may not be finite are checked here, where
+            // `submit_mesh` checks them, so both count alike; sources that
+            // are always finite (colours, lighting) skip it.
+            let checked = if A::FINITE {
+                None
+            } else {
+                let v = [var(0), var(1), var(2)];
+                if !v.iter().flatten().all(|c| c.is_finite()) {
+                    stats.rejected_nonfinite += 1;
+                    continue;
+                }
+                Some(v)
+            };
+            let vars = || checked.unwrap_or_else(|| [var(0), var(1), var(2)]);
             if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
                 // Fast path: vertices already snapped.
                 match setup_geometry::<S>(
@@ -515,7 +529,7 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
                     c.front_face,
                 ) {
                     Ok(g) => {
-                        let t = g.finish([a.inv_w, b.inv_w, d.inv_w], [var(0), var(1), var(2)], id);
+                        let t = g.finish([a.inv_w, b.inv_w, d.inv_w], vars(), id);
                         sink.take(&t);
                         stats.stored += 1;
                     }
@@ -523,10 +537,10 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
                 }
                 continue;
             }
-            let v = [a, b, d];
+            let (v, var) = ([a, b, d], vars());
             let tri: [ClipVertex<N>; 3] = core::array::from_fn(|k| ClipVertex {
                 pos: v[k].pos,
-                varyings: var(k),
+                varyings: var[k],
             });
             process_finite::<S, N, K>(stage, &tri, [a.code, b.code, d.code], id, stats, sink);
         }

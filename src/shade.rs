@@ -43,6 +43,13 @@ use embedded_graphics_core::pixelcolor::{Rgb565, Rgb888, RgbColor};
 /// `N` is the number of varyings; the layout is the implementor's (and
 /// must match the [`FragmentShader`] that reads them).
 pub trait Attributes<const N: usize> {
+    /// Whether every value [`Attributes::get`] returns is finite for any
+    /// input (colours, clamped lighting): then the pipeline does not check.
+    /// Sources of the caller's floats (texture coordinates, raw varyings)
+    /// leave it `false`, and a triangle with a NaN or infinite varying is
+    /// counted in `Stats::rejected_nonfinite` by every submission path.
+    const FINITE: bool = false;
+
     /// Whether every triangle of a mesh with `triangles` triangles and
     /// `vertices` vertices has its varyings, so [`Attributes::has`] need
     /// not be asked per triangle.
@@ -58,6 +65,8 @@ pub trait Attributes<const N: usize> {
 }
 
 impl Attributes<3> for MeshColors<'_> {
+    const FINITE: bool = true;
+
     #[inline]
     fn complete(&self, triangles: usize, vertices: usize) -> bool {
         match *self {
@@ -214,15 +223,34 @@ impl Material {
     };
 }
 
-/// `v / |v|`, or `None` for a zero or non-finite vector.
+/// `v / |v|`, or `None` for a zero or non-finite vector. Outside the
+/// range where its square is safe, the vector is scaled by its largest
+/// component first, so no finite non-zero vector under- or overflows.
 #[inline]
 fn normalize(v: Vec3) -> Option<Vec3> {
     let n2 = v.dot(v);
-    if !(n2 > 0.0 && n2.is_finite()) {
+    if n2 > 1e-30 && n2 < 1e30 {
+        let inv = 1.0 / fx::sqrt(n2);
+        return Some(Vec3::new(v.x * inv, v.y * inv, v.z * inv));
+    }
+    let m = v.x.abs().max(v.y.abs()).max(v.z.abs());
+    if !(m > 0.0 && m.is_finite()) {
         return None;
     }
-    let inv = 1.0 / fx::sqrt(n2);
-    Some(Vec3::new(v.x * inv, v.y * inv, v.z * inv))
+    let u = Vec3::new(v.x / m, v.y / m, v.z / m);
+    // 1 <= |u|^2 <= 3.
+    let inv = 1.0 / fx::sqrt(u.dot(u));
+    Some(Vec3::new(u.x * inv, u.y * inv, u.z * inv))
+}
+
+/// `v` clamped to `0.0..=255.0`, NaN to 0.
+#[inline(always)]
+fn channel(v: f32) -> f32 {
+    if v >= 0.0 {
+        v.min(255.0)
+    } else {
+        0.0
+    }
 }
 
 /// `x^n` by squaring (`n <= 1024`: at most 21 multiplications).
@@ -281,7 +309,8 @@ impl Lighting {
     /// `base` (`0.0..=255.0`) and `material` with unit normal `n`:
     /// `base * (ambient + sum max(0, n.l) c) + 255 * Ks * sum max(0,
     /// n.h)^Ns c` over the lights (no highlight where `n.l <= 0`), each
-    /// channel clamped to `0.0..=255.0`.
+    /// channel clamped to `0.0..=255.0` (a NaN from overflowing terms, such
+    /// as a huge intensity times a black base, gives 0): always finite.
     #[inline]
     pub fn shade(&self, base: [f32; 3], material: &Material, n: Vec3) -> [f32; 3] {
         let mut diffuse = self.ambient;
@@ -305,8 +334,7 @@ impl Lighting {
             }
         }
         core::array::from_fn(|c| {
-            let v = base[c] * diffuse[c] + 255.0 * material.specular[c] * spec[c];
-            v.clamp(0.0, 255.0)
+            channel(base[c] * diffuse[c] + 255.0 * material.specular[c] * spec[c])
         })
     }
 }
@@ -344,6 +372,8 @@ fn normal_of(normals: &[Vec3], vertex: u32) -> Vec3 {
 }
 
 impl Attributes<3> for LitColors<'_> {
+    const FINITE: bool = true;
+
     #[inline]
     fn complete(&self, triangles: usize, vertices: usize) -> bool {
         self.base.complete(triangles, vertices) && self.normals.len() >= vertices
@@ -401,6 +431,8 @@ pub struct ColorNormal<'a> {
 }
 
 impl Attributes<6> for ColorNormal<'_> {
+    const FINITE: bool = true;
+
     #[inline]
     fn complete(&self, triangles: usize, vertices: usize) -> bool {
         self.color.complete(triangles, vertices) && self.normals.len() >= vertices
@@ -803,6 +835,51 @@ mod tests {
             Lighting::new([0.1; 3], &[sun; 5], Vec3::new(0.0, 0.0, 1.0)),
             Err(Error::InvalidLighting)
         );
+    }
+
+    #[test]
+    fn any_finite_nonzero_direction_is_a_light() {
+        for d in [
+            Vec3::new(-1e-45, 0.0, 0.0),
+            Vec3::new(1e-30, 0.0, 0.0),
+            Vec3::new(1e20, 0.0, 0.0),
+            Vec3::new(-3.9e29, -0.5, 72.7),
+            Vec3::new(f32::MAX, f32::MAX, -f32::MAX),
+        ] {
+            let sun = DirectionalLight {
+                direction: d,
+                color: [1.0; 3],
+            };
+            let l = Lighting::new([0.1; 3], &[sun], d).unwrap();
+            let n = l.lights[0].l;
+            assert!((n.dot(n) - 1.0).abs() < 1e-5, "{d:?}: {n:?}");
+        }
+    }
+
+    #[test]
+    fn lit_colours_are_always_finite() {
+        let sun = DirectionalLight {
+            direction: Vec3::new(0.0, 0.0, 1.0),
+            color: [f32::MAX; 3],
+        };
+        let l = Lighting::new([f32::MAX; 3], &[sun; 4], Vec3::new(0.0, 0.0, 1.0)).unwrap();
+        let shiny = Material {
+            specular: [0.0, 1.0, 0.5],
+            shininess: 1,
+        };
+        for base in [[0.0; 3], [255.0; 3], [1.0, 0.0, 7.0]] {
+            for n in [
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(0.0, 0.0, 0.0),
+            ] {
+                let c = l.shade(base, &shiny, n);
+                assert!(
+                    c.iter().all(|v| (0.0..=255.0).contains(v)),
+                    "{base:?} {n:?}: {c:?}"
+                );
+            }
+        }
     }
 
     #[test]

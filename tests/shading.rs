@@ -530,3 +530,68 @@ fn measure_uv_error() {
         worst_rel.log2()
     );
 }
+
+/// Fuzzing found (fuzz/findings/nonfinite-varyings-*): a NaN texture
+/// coordinate was rejected by `submit_mesh` but drawn by
+/// `submit_mesh_cached`, and a lit colour could be NaN under lighting
+/// `Lighting::new` accepts. Both paths now count a non-finite varying as
+/// `rejected_nonfinite`, and lit colours are always finite.
+#[test]
+fn nonfinite_varyings_count_alike_on_every_mesh_path() {
+    let positions = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ];
+    let indices = [[0, 1, 2], [0, 2, 3]];
+    let uvs = [[0.0, 0.0], [1.0, f32::NAN], [1.0, 1.0], [0.0, 1.0]];
+    let t = texels();
+    let tex = Texture::new(&t, 64, 32).unwrap();
+    let mesh = Mesh {
+        positions: &positions,
+        indices: &indices,
+        attributes: microraster::shade::ColorUv {
+            color: MeshColors::Uniform(Rgb888::new(255, 255, 255)),
+            uvs: &uvs,
+        },
+        bounds: None,
+    };
+    let mvp = microraster::Mat4::translation(Vec3::new(0.0, 0.0, -0.5));
+    let mut s1 = [SetupTriangle::<5>::EMPTY; 16];
+    let mut s2 = [SetupTriangle::<5>::EMPTY; 16];
+    let mut f1 = Frame::<8, 5>::with_subpixel_bits(config(), &mut s1).unwrap();
+    let mut f2 = Frame::<8, 5>::with_subpixel_bits(config(), &mut s2).unwrap();
+    f1.submit_mesh(&mesh, &mvp, 0).unwrap();
+    let mut cache = [microraster::ProcessedVertex::EMPTY; 4];
+    f2.submit_mesh_cached(&mesh, &mvp, 0, &mut cache).unwrap();
+    assert_eq!(f1.stats(), f2.stats());
+    assert_eq!(f1.stats().rejected_nonfinite, 1);
+    assert_eq!(f1.stats().stored, 1);
+    let n = (W * H) as usize;
+    let (mut a, mut b) = (vec![TriangleId(0); n], vec![TriangleId(0); n]);
+    let fragment = Textured { texture: tex };
+    f1.render_rows_shaded(0, H, &mut a, &mut NoDepth, &fragment)
+        .unwrap();
+    f2.render_rows_shaded(0, H, &mut b, &mut NoDepth, &fragment)
+        .unwrap();
+    assert_eq!(a, b);
+
+    // Lighting that overflows: every lit colour is still finite.
+    let huge = DirectionalLight {
+        direction: Vec3::new(0.0, 0.0, 1.0),
+        color: [f32::MAX; 3],
+    };
+    let light = Lighting::new([f32::MAX; 3], &[huge], Vec3::new(0.0, 0.0, 1.0)).unwrap();
+    let normals = [Vec3::new(0.0, 0.0, 1.0); 4];
+    let black = [Rgb888::new(0, 0, 0); 4];
+    let lit = LitColors {
+        base: MeshColors::PerVertex(&black),
+        normals: &normals,
+        lighting: &light,
+        material: SHINY,
+    };
+    for k in 0..4 {
+        assert!(lit.get(0, k).iter().all(|c| (0.0..=255.0).contains(c)));
+    }
+}
