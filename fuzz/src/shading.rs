@@ -30,8 +30,8 @@
 //!   (more than `MAX_LIGHTS` lights, a zero or non-finite direction or
 //!   view, a non-finite colour or ambient);
 //! - every shading (`N = 3` `MeshColors` and `LitColors` with
-//!   `VertexColor`, `N = 5` `ColorUv` + `Textured`, `N = 6` `ColorNormal`
-//!   + `Phong`, `N = 8` `ColorUvNormal` + textured `Phong`), through
+//!   `VertexColor`, `N = 5` `ColorUv` + `Textured`, `N = 6` `ColorNormal` +
+//!   `Phong`, `N = 8` `ColorUvNormal` + textured `Phong`), through
 //!   `submit_mesh` and `submit_mesh_cached`, gives the id and depth
 //!   buffers and the `Stats` of the colour frame on the same mesh whose
 //!   triangles missing an attribute of that shading were given an
@@ -972,7 +972,7 @@ fn run_at<const S: u32>(input: &ShadeInput) {
     // Texel count: width * height, or off by the input's delta.
     let t = &r.tex;
     let want = (t.width.0 as u64 * t.height.0 as u64).min(1 << 16) as i64;
-    let n = if t.delta.0 % 4 == 0 {
+    let n = if t.delta.0.is_multiple_of(4) {
         (want + t.delta.1 as i64).clamp(0, 1 << 16)
     } else {
         want
