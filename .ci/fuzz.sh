@@ -6,6 +6,8 @@
 # micromath arms through `*_with::<Micromath>`) and one with micromath as
 # the default backend (`--no-default-features`, its own target dir), so
 # `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
+# Targets: frame, strip_renderer, shading (every shading: colours, lit
+# colours, textures, Phong; ids, depth and counters independent of it).
 # Exits non-zero when a target crashes (panic, overflow, assertion, ASan
 # report); the crashing input is left in fuzz/artifacts/<target>/.
 #
@@ -17,6 +19,10 @@
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
 #   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
+#   MICRORASTER_FUZZ_ALLOW=nonfinite-varyings,lighting-range bash .ci/fuzz.sh
+#                                         # fuzz past known findings (see
+#                                         # fuzz/src/shading.rs `allowed`);
+#                                         # unset in CI: every check strict
 #
 # Reproduce a crash:
 #   cd fuzz && cargo +nightly fuzz run -O -a <target> <file>
@@ -30,7 +36,7 @@ cd "$(dirname "$0")/.."
 # FUZZ_SECONDS per target in all: two thirds on the libm build, a third
 # on the micromath build (unless FUZZ_BUILDS names one only).
 TOTAL_SECONDS=${FUZZ_SECONDS:-60}
-TARGETS=${FUZZ_TARGETS:-"frame strip_renderer"}
+TARGETS=${FUZZ_TARGETS:-"frame strip_renderer shading"}
 BUILDS=${FUZZ_BUILDS:-"libm micromath"}
 if [ "$(echo $BUILDS | wc -w)" -gt 1 ]; then
   MICROMATH_SECONDS=$(( TOTAL_SECONDS / 3 ))

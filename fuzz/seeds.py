@@ -11,6 +11,13 @@ a few hundred to a few thousand triangles), then a short random tail that
 window, splits, pixel and depth formats, bins, wrong calls, StripDrawer).
 Deterministic (fixed random seed); the same pieces go to both targets,
 with different tails. Keep the total under ~2 MB (it prints the sizes).
+
+The `shading` target's seeds (fuzz/seeds/shading/, layout in
+`fuzz/src/shading.rs`) are pieces of spot (the one model with texture
+coordinates) with normals (face normals averaged per vertex, some pieces
+with a few zero or rescaled) and uvs (OBJ's v flipped), a few dozen under
+~200 KB, from their own random stream (the other targets' seeds do not
+change).
 """
 
 import os
@@ -133,6 +140,107 @@ def main():
                 total += len(data)
                 k += 1
     print(f"{k} seeds, {total} bytes", file=sys.stderr)
+    shading_seeds()
+
+
+def load_obj_uv(path):
+    """Positions (centred, radius 1), uvs, and triangles of (v, vt) pairs."""
+    verts, uvs, faces = [], [], []
+    with open(path) as f:
+        for line in f:
+            p = line.split()
+            if not p:
+                continue
+            if p[0] == "v":
+                verts.append(tuple(float(x) for x in p[1:4]))
+            elif p[0] == "vt":
+                uvs.append((float(p[1]), 1.0 - float(p[2])))
+            elif p[0] == "f":
+                c = []
+                for t in p[1:]:
+                    a = t.split("/")
+                    c.append((int(a[0]) - 1, int(a[1]) - 1 if len(a) > 1 and a[1] else 0))
+                for k in range(1, len(c) - 1):
+                    faces.append((c[0], c[k], c[k + 1]))
+    lo = [min(v[k] for v in verts) for k in range(3)]
+    hi = [max(v[k] for v in verts) for k in range(3)]
+    cen = [(lo[k] + hi[k]) / 2 for k in range(3)]
+    r = max(sum((v[k] - cen[k]) ** 2 for k in range(3)) ** 0.5 for v in verts)
+    verts = [tuple((v[k] - cen[k]) / r for k in range(3)) for v in verts]
+    # Smooth normals: face normals (area-weighted) summed per position.
+    acc = [[0.0, 0.0, 0.0] for _ in verts]
+    for f in faces:
+        a, b, c = (verts[i] for i, _ in f)
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        for i, _ in f:
+            for k in range(3):
+                acc[i][k] += n[k]
+    normals = []
+    for n in acc:
+        l = max(sum(x * x for x in n) ** 0.5, 1e-12)
+        normals.append(tuple(x / l for x in n))
+    return verts, normals, uvs, faces
+
+
+def q(x, scale):
+    return max(-32768, min(32767, round(x * scale)))
+
+
+def shading_seeds():
+    rng = random.Random(20261202)
+    verts, normals, uvs, faces = load_obj_uv(os.path.join(ROOT, "assets", "models", "spot.obj"))
+    d = os.path.join(ROOT, "fuzz", "seeds", "shading")
+    os.makedirs(d, exist_ok=True)
+    for f in os.listdir(d):
+        os.remove(os.path.join(d, f))
+    sizes = [(64, 48), (97, 61), (128, 96), (33, 120), (120, 33), (17, 13), (160, 100)]
+    total = count = 0
+    for n in [40, 80, 150, 250, 400] * 8:
+        start = rng.randrange(0, len(faces) - n)
+        remap, vs, tris = {}, [], []
+        for f in faces[start:start + n]:
+            t = []
+            for pair in f:
+                if pair not in remap:
+                    remap[pair] = len(vs)
+                    vs.append(pair)
+                t.append(remap[pair])
+            tris.append(t)
+        w, h = rng.choice(sizes)
+        # Most seeds: full lists, rows from the top, stock texture and
+        # lights where the tail's are refused (see fuzz/src/shading.rs).
+        flags = rng.randrange(3) | ((rng.random() < 0.5) << 2) | (rng.randrange(3) << 3)
+        flags |= (rng.random() < 0.8) << 5
+        flags |= (rng.random() < 0.8) << 6
+        flags |= (rng.random() < 0.85) << 7
+        dist = rng.choice([2.2, 3.0, 4.0, 1.5])
+        dx, dy, dz = (rng.uniform(-1, 1) for _ in range(3))
+        l = max((dx * dx + dy * dy + dz * dz) ** 0.5, 1e-3)
+        eye = (dx / l * dist, dy / l * dist, dz / l * dist)
+        fov = rng.choice([0.6, 0.9, 1.2])
+        out = struct.pack("<HHB", w, h, flags)
+        out += struct.pack("<10f", *eye, 0.0, 0.0, 0.0, fov, 0.1, 20.0, rng.uniform(-3.2, 3.2))
+        out += struct.pack("<H", len(vs))
+        odd = rng.random() < 0.3
+        for vi, ti in vs:
+            p, nm, uv = verts[vi], normals[vi], uvs[ti]
+            s = 8192
+            if odd:
+                s = rng.choice([0, 8192, 4096, 16000])  # zero or not unit
+            out += struct.pack("<3h", *(q(c, 8192) for c in p))
+            out += struct.pack("<3h", *(q(c, s) for c in nm))
+            out += struct.pack("<2h", *(q(c, 4096) for c in uv))
+        for t in tris:
+            out += struct.pack("<3H", *t)
+        tail = bytes(rng.randrange(256) for _ in range(rng.randrange(60, 200)))
+        data = struct.pack("<I", len(out)) + out + tail
+        with open(os.path.join(d, f"spot-{n}-{start}"), "wb") as f:
+            f.write(data)
+        total += len(data)
+        count += 1
+    print(f"shading: {count} seeds, {total} bytes", file=sys.stderr)
 
 
 if __name__ == "__main__":

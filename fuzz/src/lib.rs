@@ -46,6 +46,9 @@
 
 pub mod big;
 mod drawer;
+pub mod shading;
+
+pub use shading::{run_shading, ShadeInput};
 
 use big::BigMesh;
 use embedded_graphics_core::pixelcolor::{BinaryColor, Gray8, Rgb565, Rgb888, RgbColor};
