@@ -113,7 +113,7 @@ pub enum MeshColors<'a> {
 
 /// An indexed triangle mesh in object space, with the source of its
 /// varyings: colours by default ([`MeshColors`]), or any
-/// [`Attributes`](crate::shade::Attributes) (normals and lights, texture
+/// [`Attributes`] (normals and lights, texture
 /// coordinates: see [`crate::shade`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Mesh<'a, A = MeshColors<'a>> {
