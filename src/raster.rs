@@ -128,9 +128,15 @@ impl_edge_int!(i64, from_i64);
 /// sides of the limit against the `i128` reference).
 pub const EDGE32_SPAN: i64 = 45_000;
 
-/// Whether the triangle's edge values fit `i32` ([`EDGE32_SPAN`]).
+/// Whether the triangle's edge values fit `i32` ([`EDGE32_SPAN`]). Always
+/// `false` with the `no-i32-edges` feature, which exists to measure what
+/// the `i32` path saves (`microraster report speed-vs-error`, the firmware's
+/// counts); the pixels are the same.
 #[inline]
 fn fits_i32<const N: usize>(t: &SetupTriangle<N>) -> bool {
+    if cfg!(feature = "no-i32-edges") {
+        return false;
+    }
     let span = |v: [i32; 3]| v[0].max(v[1]).max(v[2]) as i64 - v[0].min(v[1]).min(v[2]) as i64;
     span(t.x) <= EDGE32_SPAN && span(t.y) <= EDGE32_SPAN
 }
