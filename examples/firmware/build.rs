@@ -197,6 +197,15 @@ impl spot_scene::Draw for HostFrame {
         frame
             .render_rows_shaded(0, HEIGHT, &mut color, &mut z[..], &fragment)
             .unwrap();
+        // To look at the frame: MICRORASTER_FIRMWARE_PPM=/path/spot.ppm.
+        if let Some(path) = env::var_os("MICRORASTER_FIRMWARE_PPM") {
+            let mut ppm = format!("P6\n{WIDTH} {HEIGHT}\n255\n").into_bytes();
+            for &c in &color {
+                let c = microraster::pixelcolor::Rgb888::from(c);
+                ppm.extend([c.r(), c.g(), c.b()]);
+            }
+            fs::write(path, ppm).unwrap();
+        }
         frame_checksum(&color)
     }
 }
@@ -275,4 +284,5 @@ fn main() {
     println!("cargo:rerun-if-changed=memory");
     println!("cargo:rerun-if-changed=baked");
     println!("cargo:rerun-if-changed=src/spot_scene.rs");
+    println!("cargo:rerun-if-env-changed=MICRORASTER_FIRMWARE_PPM");
 }

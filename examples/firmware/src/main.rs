@@ -39,6 +39,11 @@
 //! host renders the same) and `flat` with a pixel type that never asks for
 //! interpolated colour; each leaves that code out of the binary (see
 //! `docs/embedded.md` for what that saves).
+//!
+//! Features `spot-flat`, `spot-gouraud`, `spot-lit`, `spot-textured`,
+//! `spot-textured-lit` and `spot-phong` draw baked Spot instead (`spot.rs`,
+//! `spot_scene.rs`): the model and its texture in flash, immediate mode,
+//! one shading variant per build.
 
 #![no_std]
 #![no_main]
