@@ -14,6 +14,14 @@
 //! `StripRenderer` for every strip with `--features immediate`). The hash is the
 //! firmware's: `microraster_scenes::checksum::FrameChecksum` over the
 //! `Rgb565` pixels, rows top to bottom.
+//!
+//! With a `spot-*` feature the frame is baked Spot instead
+//! (`src/spot_scene.rs`, compiled here too, with the same features): the
+//! whole mesh set up once in a `Frame<8, N>` and rendered with
+//! `render_rows_shaded`, where the firmware gives every strip a
+//! `StripRenderer::with_shader`. The micro:bit gets the decimated bake
+//! (`cfg(small_spot)`), and `spot-gouraud`'s per-vertex colours are
+//! written here as a static (`spot_colors.rs`) so that they sit in flash.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
 #[cfg(not(feature = "spot"))]
