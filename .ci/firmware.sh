@@ -8,7 +8,11 @@
 # the checksum it prints to equal examples/firmware/host-checksums.txt
 # (which std-host/tests/firmware_frame.rs checks on the host). Then the
 # build variants (no depth buffer, flat colour) and the table of flash,
-# RAM and instructions, printed as markdown for docs/embedded.md.
+# RAM and instructions, printed as markdown for docs/embedded.md. Then the
+# same for baked, textured, lit Spot in its six shading variants (after
+# checking that the committed bakes are what `microraster bake` writes,
+# and that the unlit and untextured variants link no lighting or texture
+# code), with its own table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -27,6 +31,20 @@ step "core for riscv32imc-unknown-none-elf (no_std, both float backends)"
 cargo build -p microraster --release --target riscv32imc-unknown-none-elf
 cargo build -p microraster --release --target riscv32imc-unknown-none-elf --no-default-features --features micromath
 
+step "baked Spot is what microraster bake writes today (examples/firmware/baked)"
+# The commands of record (docs/embedded.md): re-bake into a temp dir and
+# require the committed files to be the same, so they cannot go stale.
+cargo build -q --release -p microraster-host
+bake=$(mktemp -d)
+target/release/microraster bake --out "$bake/full" --texture assets/models/spot_texture.png \
+  --texture-size 256 assets/models/spot.obj >/dev/null
+target/release/microraster bake --out "$bake/small" --texture assets/models/spot_texture.png \
+  --texture-size 128 --max-triangles 1500 assets/models/spot.obj >/dev/null
+diff -q "$bake/full/spot.rs" examples/firmware/baked/spot.rs
+diff -q "$bake/small/spot.rs" examples/firmware/baked/small/spot.rs
+rm -r "$bake"
+echo "baked Spot up to date"
+
 step "firmware crate: rustfmt and clippy (it is outside the workspace)"
 (
   cd examples/firmware
@@ -35,10 +53,13 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
     cargo clippy -q --release --target "$target" -- -D warnings
     cargo clippy -q --release --target "$target" --features no-depth,flat -- -D warnings
     cargo clippy -q --release --target "$target" --features immediate -- -D warnings
+    for v in spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong; do
+      cargo clippy -q --release --target "$target" --features "$v" -- -D warnings
+    done
   done
 )
 
-expected() { awk -v k="$1" '$1 == k { print $2 }' examples/firmware/host-checksums.txt; }
+expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
 want_depth=$(expected depth-u16)
 want_nodepth=$(expected no-depth)
 test -n "$want_depth" && test -n "$want_nodepth"
@@ -49,6 +70,9 @@ boards=(
   "thumbv6m-none-eabi microbit"
 )
 variants=("" "flat" "no-depth" "no-depth,flat" "immediate")
+# Spot (baked, immediate mode), one shading variant each; the micro:bit
+# draws the decimated bake, so its checksums have keys of their own.
+spot_variants=(spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong)
 table_header="| board | features | flash B | statics B | stack B | RAM B | pixels written | instructions/frame | display push | render | clears | geometry (all strips) | rasterization | render instr/px |"
 # Columns 8-13 of the table (frame, display push, render, clears,
 # geometry, rasterization) are the instruction counts of record.
@@ -84,6 +108,39 @@ check_counts() {
   done
   return "$bad"
 }
+# shade_fns ELF: the lighting and texture functions of the core's shading
+# module that the ELF's debug info names (out of line or inlined), one a
+# line: "lighting NAME" or "texture NAME".
+shade_fns() {
+  arm-none-eabi-objdump --dwarf=info "$1" | awk '/DW_AT_linkage_name/ { print $NF }' |
+    arm-none-eabi-c++filt | sed 's/::h[0-9a-f]\{16\}$//' | sort -u | awk '
+      /microraster::shade::(Lighting|LitColors|Phong|ColorNormal|ColorUvNormal|normalize|powi|pixel_normal)/ { print "lighting", $0 }
+      /microraster::shade::(Texture|Textured|ColorUv|Phong<microraster::shade::Texture)/ { print "texture", $0 }'
+}
+
+# check_linked BOARD VARIANT ELF: an unlit variant links no lighting code
+# and an untextured one no texture code (and the others do, so the check
+# is not vacuous).
+check_linked() {
+  local board=$1 v=$2 elf=$3 fns lit tex
+  fns=$(shade_fns "$elf")
+  lit=$(grep -c '^lighting' <<<"$fns" || true)
+  tex=$(grep -c '^texture' <<<"$fns" || true)
+  case $v in spot-lit | spot-textured-lit | spot-phong) want_lit=1 ;; *) want_lit=0 ;; esac
+  case $v in spot-textured | spot-textured-lit | spot-phong) want_tex=1 ;; *) want_tex=0 ;; esac
+  echo "linked: $lit lighting and $tex texture functions of microraster::shade"
+  if [ "$want_lit" = 0 ] && [ "$lit" != 0 ]; then
+    echo "FAIL: $board $v is unlit but links lighting code:"; grep '^lighting' <<<"$fns"; return 1
+  fi
+  if [ "$want_tex" = 0 ] && [ "$tex" != 0 ]; then
+    echo "FAIL: $board $v is untextured but links texture code:"; grep '^texture' <<<"$fns"; return 1
+  fi
+  if { [ "$want_lit" = 1 ] && [ "$lit" = 0 ]; } || { [ "$want_tex" = 1 ] && [ "$tex" = 0 ]; }; then
+    echo "FAIL: $board $v: no lighting or texture function found where one must be (is the check broken?)"
+    return 1
+  fi
+}
+
 log=$root/target/firmware
 mkdir -p "$log"
 rows=()
@@ -143,12 +200,64 @@ for b in "${boards[@]}"; do
     check_counts "$board" "$name" "$frame $display $render $clears $geometry $raster" || failed=1
   done
 done
+
+spot_rows=()
+for b in "${boards[@]}"; do
+  read -r target board <<<"$b"
+  for v in "${spot_variants[@]}"; do
+    step "$board ($target), Spot: $v"
+    out=$log/$board-$v.txt
+    set +e
+    timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
+    rc=$?
+    set -e
+    cat "$out"
+    elf=target/$target/release/microraster-firmware
+    if [ "$rc" -ne 0 ]; then
+      echo "FAIL: $board $v exited $rc"
+      failed=1
+      continue
+    fi
+    got=$(awk '$1 == "checksum" { print $2 }' "$out")
+    case $board in microbit) key=$v-microbit ;; *) key=$v ;; esac
+    want=$(expected "$key")
+    if [ -z "$want" ] || [ "$got" != "$want" ]; then
+      echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
+      failed=1
+    fi
+    check_linked "$board" "$v" "$elf" || failed=1
+    read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
+    pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
+    display=$(sed -n 's/^ *display push (checksum) *\([0-9]*\) .*/\1/p' "$out")
+    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
+    render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
+    clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
+    geometry=$(sed -n -E 's/^ *geometry x [0-9]+ strips +([0-9]+) .*/\1/p' "$out")
+    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
+    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
+    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
+    ram=$((statics + stack))
+    case $board in microbit) budget=16384 ;; *) budget=24576 ;; esac
+    if [ "$ram" -gt "$budget" ]; then
+      echo "FAIL: $board $v uses $ram B of RAM, over the $budget B budget"
+      failed=1
+    fi
+    spot_rows+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
+    check_counts "$board" "$v" "$frame $display $render $clears $geometry $raster" || failed=1
+  done
+done
 cd "$root"
 
 step "budget table (320x240 Rgb565, four cubes; paste into docs/embedded.md when the counts change)"
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${rows[@]}"
+
+step "Spot, shading variants (320x240 Rgb565, u16 depth, immediate; the same table in docs/embedded.md)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${spot_rows[@]}"
 
 if [ "$failed" -ne 0 ]; then
   echo

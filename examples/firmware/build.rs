@@ -14,10 +14,23 @@
 //! `StripRenderer` for every strip with `--features immediate`). The hash is the
 //! firmware's: `microraster_scenes::checksum::FrameChecksum` over the
 //! `Rgb565` pixels, rows top to bottom.
+//!
+//! With a `spot-*` feature the frame is baked Spot instead
+//! (`src/spot_scene.rs`, compiled here too, with the same features): the
+//! whole mesh set up once in a `Frame<8, N>` and rendered with
+//! `render_rows_shaded`, where the firmware gives every strip a
+//! `StripRenderer::with_shader`. The micro:bit gets the decimated bake
+//! (`cfg(small_spot)`), and `spot-gouraud`'s per-vertex colours are
+//! written here as a static (`spot_colors.rs`) so that they sit in flash.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
-use microraster::{Config, Frame, NoDepth, SetupTriangle, Submit};
+#[cfg(not(feature = "spot"))]
+use microraster::NoDepth;
+#[cfg(feature = "spot")]
+use microraster::{Attributes, FragmentShader, Mesh};
+use microraster::{Config, Frame, SetupTriangle, Submit};
 use microraster_scenes::checksum::FrameChecksum;
+#[cfg(not(feature = "spot"))]
 use microraster_scenes::cubes;
 use std::env;
 use std::fmt::Write as _;
@@ -26,6 +39,32 @@ use std::path::PathBuf;
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
+
+/// The Spot frame's shading (the firmware's own file, compiled here with
+/// the same features).
+#[cfg(feature = "spot")]
+#[path = "src/spot_scene.rs"]
+mod spot_scene;
+
+/// The baked models: all of Spot (MPS2 boards) and Spot decimated to
+/// 1,478 triangles with a 128x128 texture (the micro:bit's 256 KB flash).
+#[cfg(feature = "spot")]
+#[allow(dead_code)]
+mod spot_full {
+    include!("baked/spot.rs");
+}
+#[cfg(feature = "spot")]
+#[allow(dead_code)]
+mod spot_small {
+    include!("baked/small/spot.rs");
+}
+
+/// Spot's rows per strip (immediate mode, 1,280 B a row of colour and
+/// depth; the stack needs 2.5 to 3.5 KB beside them). MPS2 (24 KB): 16
+/// rows, 15 strips (17 would fit but still take 15 strips). micro:bit
+/// (16 KB): 9 rows, 27 strips (10 would leave `spot-phong` 64 bytes).
+const SPOT_ROWS_MPS2: u32 = 16;
+const SPOT_ROWS_MICROBIT: u32 = 9;
 
 struct Board {
     name: &'static str,
@@ -38,9 +77,16 @@ struct Board {
 /// mode (`immediate` feature) needs no setup storage, so its strips can
 /// be taller; set-up-once mode keeps the frame's set-up triangles
 /// (`SETUP_CAPACITY` of them, 112 B each) and pays for them in strip rows.
-fn board(target: &str, immediate: bool) -> Board {
+fn board(target: &str, immediate: bool, spot: bool) -> Board {
     let rows = |setup_once: u32, immediate_rows: u32| {
-        if immediate {
+        if spot {
+            // Spot: immediate mode, the rows that fit beside the stack
+            // (the model and texture are in flash).
+            match target {
+                "thumbv6m-none-eabi" => SPOT_ROWS_MICROBIT,
+                _ => SPOT_ROWS_MPS2,
+            }
+        } else if immediate {
             immediate_rows
         } else {
             setup_once
@@ -85,6 +131,7 @@ fn frame_checksum(pixels: &[Rgb565]) -> u64 {
     c.value()
 }
 
+#[cfg(not(feature = "spot"))]
 fn host_checksum(depth: bool) -> u64 {
     let mut storage = vec![SetupTriangle::EMPTY; cubes::CUBE_INDICES.len() * 4 * 7];
     let mut frame = Frame::new(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
@@ -103,17 +150,122 @@ fn host_checksum(depth: bool) -> u64 {
     frame_checksum(&color)
 }
 
+/// Spot's model for the target, with the `spot-gouraud` colours.
+#[cfg(feature = "spot")]
+fn spot_model(small: bool) -> spot_scene::Model<'static> {
+    macro_rules! model {
+        ($m:ident) => {
+            spot_scene::Model {
+                positions: &$m::POSITIONS,
+                indices: &$m::INDICES,
+                normals: &$m::NORMALS,
+                uvs: &$m::UVS,
+                texture: &$m::TEXTURE,
+                texture_width: $m::TEXTURE_WIDTH,
+                texture_height: $m::TEXTURE_HEIGHT,
+                diffuse: $m::MATERIAL_DIFFUSE[0],
+                colors: Vec::leak(
+                    $m::NORMALS
+                        .iter()
+                        .map(|&n| spot_scene::normal_color(n))
+                        .collect(),
+                ),
+            }
+        };
+    }
+    if small {
+        model!(spot_small)
+    } else {
+        model!(spot_full)
+    }
+}
+
+/// The host's path for Spot: the whole mesh set up once in one `Frame`
+/// and rendered as one 240-row strip with `render_rows_shaded`.
+#[cfg(feature = "spot")]
+struct HostFrame;
+
+#[cfg(feature = "spot")]
+impl spot_scene::Draw for HostFrame {
+    type Out = u64;
+    fn draw<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+        self,
+        mesh: &Mesh<'_, A>,
+        fragment: F,
+    ) -> u64 {
+        let mut storage = vec![SetupTriangle::<N>::EMPTY; mesh.indices.len() * 7];
+        let config = Config::new(WIDTH, HEIGHT);
+        let mut frame = Frame::<8, N>::with_subpixel_bits(config, &mut storage).unwrap();
+        frame
+            .submit_mesh(mesh, &spot_scene::mvp(WIDTH, HEIGHT), 0)
+            .unwrap();
+        let n = (WIDTH * HEIGHT) as usize;
+        let mut color = vec![Rgb565::BLACK; n];
+        let mut z = vec![u16::MAX; n];
+        frame
+            .render_rows_shaded(0, HEIGHT, &mut color, &mut z[..], &fragment)
+            .unwrap();
+        // To look at the frame: MICRORASTER_FIRMWARE_PPM=/path/spot.ppm.
+        if let Some(path) = env::var_os("MICRORASTER_FIRMWARE_PPM") {
+            let mut ppm = format!("P6\n{WIDTH} {HEIGHT}\n255\n").into_bytes();
+            for &c in &color {
+                let c = microraster::pixelcolor::Rgb888::from(c);
+                ppm.extend([c.r(), c.g(), c.b()]);
+            }
+            fs::write(path, ppm).unwrap();
+        }
+        frame_checksum(&color)
+    }
+}
+
+/// Writes `spot_colors.rs` (the `spot-gouraud` colours as a static, for
+/// flash) and returns the host's checksum of the Spot frame.
+#[cfg(feature = "spot")]
+fn spot_frame(out: &std::path::Path, small: bool) -> u64 {
+    let model = spot_model(small);
+    let mut s = String::from(
+        "/// `spot-gouraud`'s colours: each vertex normal `n` as `(n + 1) / 2` (build.rs).\n\
+         pub static COLORS: [microraster::pixelcolor::Rgb888; ",
+    );
+    writeln!(s, "{}] = [", model.colors.len()).unwrap();
+    for c in model.colors {
+        use microraster::pixelcolor::RgbColor;
+        writeln!(
+            s,
+            "    microraster::pixelcolor::Rgb888::new({}, {}, {}),",
+            c.r(),
+            c.g(),
+            c.b()
+        )
+        .unwrap();
+    }
+    s.push_str("];\n");
+    fs::write(out.join("spot_colors.rs"), s).unwrap();
+    spot_scene::draw(&model, HostFrame).unwrap()
+}
+
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let target = env::var("TARGET").unwrap();
     let immediate = env::var_os("CARGO_FEATURE_IMMEDIATE").is_some();
-    let b = board(&target, immediate);
+    let spot = cfg!(feature = "spot");
+    // The micro:bit's flash takes the decimated Spot.
+    let small = target == "thumbv6m-none-eabi";
+    println!("cargo::rustc-check-cfg=cfg(small_spot)");
+    if spot && small {
+        println!("cargo::rustc-cfg=small_spot");
+    }
+    let b = board(&target, immediate, spot);
+    #[cfg(not(feature = "spot"))]
     let depth = env::var_os("CARGO_FEATURE_NO_DEPTH").is_none();
 
     let memory = fs::read_to_string(format!("memory/{}", b.memory)).unwrap();
     fs::write(out.join("memory.x"), memory).unwrap();
     println!("cargo:rustc-link-search={}", out.display());
 
+    #[cfg(feature = "spot")]
+    let checksum = spot_frame(&out, small);
+    #[cfg(not(feature = "spot"))]
     let checksum = host_checksum(depth);
     let mut s = String::new();
     writeln!(
@@ -138,4 +290,7 @@ fn main() {
 
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=memory");
+    println!("cargo:rerun-if-changed=baked");
+    println!("cargo:rerun-if-changed=src/spot_scene.rs");
+    println!("cargo:rerun-if-env-changed=MICRORASTER_FIRMWARE_PPM");
 }

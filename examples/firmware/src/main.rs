@@ -39,25 +39,42 @@
 //! host renders the same) and `flat` with a pixel type that never asks for
 //! interpolated colour; each leaves that code out of the binary (see
 //! `docs/embedded.md` for what that saves).
+//!
+//! Features `spot-flat`, `spot-gouraud`, `spot-lit`, `spot-textured`,
+//! `spot-textured-lit` and `spot-phong` draw baked Spot instead (`spot.rs`,
+//! `spot_scene.rs`): the model and its texture in flash, immediate mode,
+//! one shading variant per build.
 
 #![no_std]
 #![no_main]
 
 mod clock;
 mod display;
+#[cfg(feature = "spot")]
+mod spot;
+#[cfg(feature = "spot")]
+mod spot_scene;
 
+#[cfg(not(feature = "spot"))]
 use clock::Clock;
+#[cfg(not(feature = "spot"))]
 use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::debug;
+#[cfg(not(feature = "spot"))]
+use cortex_m_semihosting::hprintln;
+#[cfg(not(feature = "spot"))]
 use display::HashDisplay;
-#[cfg(feature = "flat")]
+#[cfg(all(feature = "flat", not(feature = "spot")))]
 use microraster::pixelcolor::Rgb888;
+#[cfg(not(feature = "spot"))]
 use microraster::pixelcolor::{Rgb565, RgbColor};
-#[cfg(not(feature = "immediate"))]
+#[cfg(not(any(feature = "immediate", feature = "spot")))]
 use microraster::SetupTriangle;
-#[cfg(feature = "immediate")]
+#[cfg(all(feature = "immediate", not(feature = "spot")))]
 use microraster::StripRenderer;
+#[cfg(not(feature = "spot"))]
 use microraster::{Config, ProcessedVertex, StripDrawer, Submit};
+#[cfg(not(feature = "spot"))]
 use microraster_scenes::cubes;
 use panic_semihosting as _;
 
@@ -70,13 +87,15 @@ const STRIP_LEN: usize = WIDTH as usize * STRIP_ROWS;
 /// Set-up triangles the frame can hold: the four cubes' 48 triangles,
 /// of which at most half face the camera (the rest are culled as back
 /// faces before storage), with room for clipped pieces.
-#[cfg(not(feature = "immediate"))]
+#[cfg(not(any(feature = "immediate", feature = "spot")))]
 const SETUP_CAPACITY: usize = 32;
 
 /// The strip buffer's pixel: the display's own `Rgb565`, or with `flat`
 /// [`Flat565`].
+#[cfg(not(feature = "spot"))]
 #[cfg(not(feature = "flat"))]
 type StripPixel = Rgb565;
+#[cfg(not(feature = "spot"))]
 #[cfg(feature = "flat")]
 type StripPixel = Flat565;
 
@@ -105,6 +124,7 @@ impl From<Flat565> for Rgb565 {
     }
 }
 
+#[cfg(not(feature = "spot"))]
 const BLACK: StripPixel = {
     #[cfg(feature = "flat")]
     {
@@ -118,10 +138,12 @@ const BLACK: StripPixel = {
 
 /// The four cubes' corners, transformed, outcoded and snapped once per
 /// frame (8 per cube): what every strip's submission starts from.
+#[cfg(not(feature = "spot"))]
 type Vertices = [ProcessedVertex; 4 * 8];
 
 /// Processes the four cubes' vertices for a frame of `config` (once per
 /// frame: the result does not depend on the strip).
+#[cfg(not(feature = "spot"))]
 fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
     // A frame with no storage is enough to run the vertex stage.
     let probe = microraster::Frame::new(config, &mut []);
@@ -135,7 +157,7 @@ fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
 /// Submits the four cubes to one strip (triangle ids as in
 /// `cubes::for_each_cube`); triangles wholly above or below the strip are
 /// skipped before setup.
-#[cfg(feature = "immediate")]
+#[cfg(all(feature = "immediate", not(feature = "spot")))]
 fn submit<D>(strip: &mut StripRenderer<'_, StripPixel, D>, vertices: &Vertices)
 where
     D: microraster::DepthBuffer + ?Sized,
@@ -180,6 +202,7 @@ fn ratio(n: u64, d: u64) -> (u64, u64) {
     (t / 10, t % 10)
 }
 
+#[cfg(not(feature = "spot"))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [StripPixel; STRIP_LEN] = [BLACK; STRIP_LEN];

@@ -1,0 +1,282 @@
+//! The Spot frame (`--features spot-*`): baked, textured, lit Spot at
+//! 320x240 `Rgb565` with a `u16` depth buffer, in immediate mode.
+//!
+//! The model and its texture are statics in flash (`baked/spot.rs`, or the
+//! decimated `baked/small/spot.rs` on the micro:bit: build.rs says which);
+//! RAM holds only the strip's colour and depth rows. Every strip gets a
+//! `StripRenderer::with_shader` with the variant's fragment shader and the
+//! whole mesh submitted again (`submit_mesh`: each triangle's vertices are
+//! transformed as it is submitted, no vertex cache, which would not fit),
+//! then the strip is pushed to the display stand-in as one
+//! `fill_contiguous`, as `StripDrawer` does for unshaded frames.
+//!
+//! The split is measured as in the cubes' immediate mode: geometry is the
+//! mesh submitted to a one-row strip, times the strips (so it includes one
+//! row's pixels), the clears one strip's clear times the strips, and
+//! rasterization (with shading) the rest of the render.
+
+use crate::clock::Clock;
+use crate::display::HashDisplay;
+use crate::spot_scene::{self, Draw, Model};
+use crate::{
+    exit, ram_use, ratio, BOARD, CORE, HEIGHT, HOST_CHECKSUM, STRIP_LEN, STRIP_ROWS, WIDTH,
+};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::hprintln;
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
+use microraster::pixelcolor::{Rgb565, RgbColor};
+use microraster::{Attributes, Config, FragmentShader, Mat4, Mesh, StripRenderer, Submit};
+
+/// The baked model (`microraster bake`, see docs/embedded.md).
+#[cfg(not(small_spot))]
+#[allow(dead_code)]
+mod baked {
+    include!("../baked/spot.rs");
+}
+#[cfg(small_spot)]
+#[allow(dead_code)]
+mod baked {
+    include!("../baked/small/spot.rs");
+}
+/// `COLORS`: the `spot-gouraud` colours, one per vertex (build.rs).
+#[allow(dead_code)]
+mod colors {
+    include!(concat!(env!("OUT_DIR"), "/spot_colors.rs"));
+}
+
+/// What a frame took, in SysTick ticks.
+struct Measured {
+    /// Pixels written, or the error that stopped the frame.
+    written: Result<u64, &'static str>,
+    /// Camera and lighting set-up before the first strip.
+    setup_start: u64,
+    /// The first strip began.
+    strips_start: u64,
+    /// The last strip was pushed.
+    end: u64,
+    /// One strip's clear.
+    one_clear: u64,
+    /// The mesh submitted to a one-row strip.
+    one_row: u64,
+}
+
+/// The firmware's strip loop.
+struct Strips<'a> {
+    config: Config,
+    mvp: Mat4,
+    color: &'a mut [Rgb565],
+    depth: &'a mut [u16],
+    display: &'a mut HashDisplay,
+    t0: u64,
+}
+
+impl Draw for Strips<'_> {
+    type Out = Measured;
+
+    fn draw<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+        self,
+        mesh: &Mesh<'_, A>,
+        fragment: F,
+    ) -> Measured {
+        let Strips {
+            config,
+            mvp,
+            color,
+            depth,
+            display,
+            t0,
+        } = self;
+        let strips_start = display.clock.now();
+        let written = frame(config, &mvp, color, depth, display, mesh, fragment);
+        let end = display.clock.now();
+
+        let clock = &mut display.clock;
+        let t = clock.now();
+        color.fill(Rgb565::BLACK);
+        depth.fill(u16::MAX);
+        let one_clear = clock.now() - t;
+
+        let t = clock.now();
+        let w = WIDTH as usize;
+        let one = StripRenderer::<_, _, 8, N, _>::with_shader(
+            config,
+            HEIGHT / 2,
+            HEIGHT / 2 + 1,
+            &mut color[..w],
+            &mut depth[..w],
+            fragment,
+        );
+        if let Ok(mut one) = one {
+            let _ = one.submit_mesh(mesh, &mvp, 0);
+        }
+        let one_row = clock.now() - t;
+        Measured {
+            written,
+            setup_start: t0,
+            strips_start,
+            end,
+            one_clear,
+            one_row,
+        }
+    }
+}
+
+/// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
+/// push the rows. The pixels written.
+fn frame<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+    config: Config,
+    mvp: &Mat4,
+    color: &mut [Rgb565],
+    depth: &mut [u16],
+    display: &mut HashDisplay,
+    mesh: &Mesh<'_, A>,
+    fragment: F,
+) -> Result<u64, &'static str> {
+    let mut written = 0;
+    let mut y0 = 0;
+    while y0 < HEIGHT {
+        let y1 = (y0 + STRIP_ROWS as u32).min(HEIGHT);
+        let len = WIDTH as usize * (y1 - y0) as usize;
+        let (color, depth) = (&mut color[..len], &mut depth[..len]);
+        color.fill(Rgb565::BLACK);
+        depth.fill(u16::MAX);
+        let mut strip =
+            StripRenderer::<_, _, 8, N, _>::with_shader(config, y0, y1, color, depth, fragment)
+                .map_err(|_| "strip renderer")?;
+        strip.submit_mesh(mesh, mvp, 0).map_err(|_| "submit")?;
+        written += strip.render_stats().pixels_written;
+        push(display, y0, y1, color)?;
+        y0 = y1;
+    }
+    Ok(written)
+}
+
+/// Pushes rows `y0..y1` to the display as one `fill_contiguous`. Out of
+/// line, so that the push compiles (and counts) the same whatever the
+/// shading around it.
+#[inline(never)]
+fn push(display: &mut HashDisplay, y0: u32, y1: u32, rows: &[Rgb565]) -> Result<(), &'static str> {
+    let area = Rectangle::new(Point::new(0, y0 as i32), Size::new(WIDTH, y1 - y0));
+    display
+        .fill_contiguous(&area, rows.iter().copied())
+        .map_err(|_| "display")
+}
+
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [Rgb565; STRIP_LEN] = [Rgb565::BLACK; STRIP_LEN];
+    static mut DEPTH: [u16; STRIP_LEN] = [0; STRIP_LEN];
+
+    let p = cortex_m::Peripherals::take().unwrap();
+    let mut clock = Clock::start(p.SYST);
+    let (cal_instr, cal_ticks) = clock.instructions_per_tick();
+    let instr = |ticks: u64| ticks * cal_instr / cal_ticks;
+    let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
+    let model = Model {
+        positions: &baked::POSITIONS,
+        indices: &baked::INDICES,
+        normals: &baked::NORMALS,
+        uvs: &baked::UVS,
+        texture: &baked::TEXTURE,
+        texture_width: baked::TEXTURE_WIDTH,
+        texture_height: baked::TEXTURE_HEIGHT,
+        diffuse: baked::MATERIAL_DIFFUSE[0],
+        colors: &colors::COLORS,
+    };
+
+    let t0 = display.clock.now();
+    let config = Config::new(WIDTH, HEIGHT);
+    let strips = Strips {
+        config,
+        mvp: spot_scene::mvp(WIDTH, HEIGHT),
+        color: &mut COLOR[..],
+        depth: &mut DEPTH[..],
+        display: &mut display,
+        t0,
+    };
+    let m = match spot_scene::draw(&model, strips) {
+        Ok(m) => m,
+        Err(e) => {
+            hprintln!("FAIL: scene: {}", e);
+            exit(false)
+        }
+    };
+    let written = match m.written {
+        Ok(w) => w,
+        Err(e) => {
+            hprintln!("FAIL: drawing the frame: {}", e);
+            exit(false)
+        }
+    };
+    let checksum = display.checksum();
+    let (statics, stack) = ram_use();
+
+    let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
+    let frame = instr(m.end - m.setup_start);
+    let shown = instr(display.ticks);
+    let render = frame - shown;
+    let clears = instr(m.one_clear * strips);
+    let geometry =
+        instr(m.one_row * strips + (m.strips_start - m.setup_start)).min(render - clears);
+    let raster = render - clears - geometry;
+    let per_px = |n: u64| ratio(n, written);
+
+    hprintln!(
+        "microraster firmware: {} ({}), {}x{} Rgb565, depth u16, Spot ({} triangles), {}, immediate, {} strips of {} rows",
+        BOARD,
+        CORE,
+        WIDTH,
+        HEIGHT,
+        model.indices.len(),
+        spot_scene::VARIANT,
+        strips,
+        STRIP_ROWS,
+    );
+    hprintln!("checksum {:#018x}", checksum.unwrap_or(0));
+    hprintln!("host     {:#018x}", HOST_CHECKSUM);
+    let (a, b) = ratio(cal_instr, cal_ticks);
+    hprintln!("instructions per SysTick tick {}.{}", a, b);
+    let (a, b) = per_px(frame);
+    hprintln!(
+        "instructions per frame {}; pixels written {}; per written pixel {}.{}",
+        frame,
+        written,
+        a,
+        b
+    );
+    let (a, b) = per_px(shown);
+    hprintln!("  display push (checksum)  {} ({}.{}/px)", shown, a, b);
+    let (a, b) = per_px(render);
+    hprintln!("  render                   {} ({}.{}/px)", render, a, b);
+    let (a, b) = per_px(clears);
+    hprintln!("    strip clears           {} ({}.{}/px)", clears, a, b);
+    let (a, b) = per_px(geometry);
+    hprintln!(
+        "    geometry x {} strips   {} ({}.{}/px)",
+        strips,
+        geometry,
+        a,
+        b
+    );
+    let (a, b) = per_px(raster);
+    hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
+    match stack {
+        Some(s) => hprintln!(
+            "ram statics {} B + stack high-water {} B = {} B",
+            statics,
+            s,
+            statics + s
+        ),
+        None => hprintln!("ram statics {} B + stack: OVERFLOWED", statics),
+    }
+
+    let pass = checksum == Some(HOST_CHECKSUM) && stack.is_some();
+    if pass {
+        hprintln!("PASS: bit-identical to the host");
+    } else {
+        hprintln!("FAIL: the frame differs from the host's, or the stack overflowed");
+    }
+    exit(pass)
+}

@@ -1,0 +1,217 @@
+//! The Spot frame, shared by the firmware (`--features spot-*`) and
+//! `build.rs` (which compiles this file with `#[path]` and the same
+//! features, and renders the same frame on the host).
+//!
+//! Spot (`assets/models/spot.obj`, baked into `baked/`) seen from a fixed
+//! camera in front of its face, with the model matrix the identity, so
+//! normals, the light and the view direction are all in object space. One
+//! shading variant is chosen at build time, by feature; only that
+//! variant's attribute source and fragment shader are instantiated, so an
+//! unlit, untextured build links no lighting and no texture code:
+//!
+//! | feature | attributes (`N`) | fragment shader |
+//! |---|---|---|
+//! | `spot-flat` | `MeshColors::Uniform` (the material's grey) (3) | `VertexColor` |
+//! | `spot-gouraud` | `MeshColors::PerVertex`: colours from the normals, `(n + 1) / 2` (3) | `VertexColor` |
+//! | `spot-lit` | `LitColors` over the grey (3) | `VertexColor` |
+//! | `spot-textured` | `ColorUv { Uniform(white) }` (5) | `Textured` |
+//! | `spot-textured-lit` | `ColorUv { LitColors over white }` (5) | `Textured` |
+//! | `spot-phong` | `ColorUvNormal { Uniform(white) }` (8) | `Phong` with the texture |
+
+#[cfg(not(any(
+    feature = "spot-flat",
+    feature = "spot-gouraud",
+    feature = "spot-lit",
+    feature = "spot-textured",
+    feature = "spot-textured-lit",
+    feature = "spot-phong"
+)))]
+compile_error!(
+    "feature `spot` needs a shading variant: spot-flat, spot-gouraud, spot-lit, \
+     spot-textured, spot-textured-lit or spot-phong"
+);
+
+const _: () = assert!(
+    cfg!(feature = "spot-flat") as u8
+        + cfg!(feature = "spot-gouraud") as u8
+        + cfg!(feature = "spot-lit") as u8
+        + cfg!(feature = "spot-textured") as u8
+        + cfg!(feature = "spot-textured-lit") as u8
+        + cfg!(feature = "spot-phong") as u8
+        <= 1,
+    "pick one Spot shading variant"
+);
+
+use microraster::math::radians;
+#[allow(unused_imports)]
+use microraster::pixelcolor::{Rgb888, RgbColor};
+#[allow(unused_imports)]
+use microraster::shade::{
+    ColorUv, ColorUvNormal, DirectionalLight, Lighting, LitColors, Material, Phong, Texture,
+    Textured,
+};
+#[allow(unused_imports)]
+use microraster::{Attributes, Error, FragmentShader, Mat4, Mesh, MeshColors, Vec3, VertexColor};
+
+/// The camera: in front of Spot's face (Spot faces -z), a little above it.
+pub const EYE: Vec3 = Vec3::new(0.0, 0.3, -2.6);
+/// The point the camera looks at.
+pub const TARGET: Vec3 = Vec3::new(0.0, 0.1, 0.2);
+
+/// The feature's name, for the firmware's first line.
+#[allow(dead_code)]
+pub const VARIANT: &str = if cfg!(feature = "spot-flat") {
+    "flat (uniform colour, unlit)"
+} else if cfg!(feature = "spot-gouraud") {
+    "Gouraud (colours from the normals, unlit)"
+} else if cfg!(feature = "spot-lit") {
+    "lit Gouraud (LitColors)"
+} else if cfg!(feature = "spot-textured") {
+    "textured (unlit)"
+} else if cfg!(feature = "spot-textured-lit") {
+    "textured, lit per vertex"
+} else {
+    "Phong, textured"
+};
+
+/// The baked model, as slices (in flash on the device); each variant reads
+/// some of the fields.
+#[allow(dead_code)]
+pub struct Model<'a> {
+    pub positions: &'a [Vec3],
+    pub indices: &'a [[u32; 3]],
+    pub normals: &'a [Vec3],
+    pub uvs: &'a [[f32; 2]],
+    /// Rgb565 words, row 0 first.
+    pub texture: &'a [u16],
+    pub texture_width: u32,
+    pub texture_height: u32,
+    /// The material's diffuse colour.
+    pub diffuse: [u8; 3],
+    /// Per-vertex colours for `spot-gouraud` ([`normal_color`] of each
+    /// normal; baked by build.rs).
+    pub colors: &'a [Rgb888],
+}
+
+/// The `spot-gouraud` colour of a vertex: its unit normal mapped from
+/// `-1..1` to `0..255` per axis (x red, y green, z blue).
+#[allow(dead_code)]
+pub fn normal_color(n: Vec3) -> Rgb888 {
+    let c = |x: f32| ((x * 0.5 + 0.5) * 255.0 + 0.5).clamp(0.0, 255.0) as u8;
+    Rgb888::new(c(n.x), c(n.y), c(n.z))
+}
+
+/// Object to clip space for a `width x height` frame (45 degree vertical
+/// field of view).
+pub fn mvp(width: u32, height: u32) -> Mat4 {
+    Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
+        * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0))
+}
+
+/// Ambient plus one white-ish key light above the viewer's left, in
+/// object space (the viewer looks along +z, so its left is +x).
+#[allow(dead_code)]
+pub fn lighting() -> Result<Lighting, Error> {
+    let key = DirectionalLight {
+        direction: Vec3::new(0.5, 0.7, -1.0),
+        color: [0.85, 0.85, 0.85],
+    };
+    Lighting::new([0.25, 0.25, 0.25], &[key], EYE - TARGET)
+}
+
+/// The surface of the lit variants: a faint highlight.
+#[allow(dead_code)]
+pub const MATERIAL: Material = Material {
+    specular: [0.2, 0.2, 0.2],
+    shininess: 24,
+};
+
+/// What draws the frame: the firmware's strip loop, or build.rs's one
+/// `Frame`.
+pub trait Draw {
+    type Out;
+    fn draw<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+        self,
+        mesh: &Mesh<'_, A>,
+        fragment: F,
+    ) -> Self::Out;
+}
+
+fn mesh<'a, A>(model: &Model<'a>, attributes: A) -> Mesh<'a, A> {
+    Mesh {
+        positions: model.positions,
+        indices: model.indices,
+        attributes,
+        bounds: None,
+    }
+}
+
+/// Draws `model` with the shading the features select, through `d`.
+#[allow(clippy::needless_return)]
+pub fn draw<D: Draw>(model: &Model<'_>, d: D) -> Result<D::Out, Error> {
+    #[allow(unused_variables)]
+    let [r, g, b] = model.diffuse;
+    #[allow(unused_variables)]
+    let grey = Rgb888::new(r, g, b);
+    #[cfg(feature = "spot-flat")]
+    return Ok(d.draw(&mesh(model, MeshColors::Uniform(grey)), VertexColor));
+    #[cfg(feature = "spot-gouraud")]
+    return Ok(d.draw(
+        &mesh(model, MeshColors::PerVertex(model.colors)),
+        VertexColor,
+    ));
+    #[cfg(feature = "spot-lit")]
+    {
+        let lighting = lighting()?;
+        let lit = LitColors {
+            base: MeshColors::Uniform(grey),
+            normals: model.normals,
+            lighting: &lighting,
+            material: MATERIAL,
+        };
+        return Ok(d.draw(&mesh(model, lit), VertexColor));
+    }
+    #[cfg(any(
+        feature = "spot-textured",
+        feature = "spot-textured-lit",
+        feature = "spot-phong"
+    ))]
+    let texture = Texture::new(model.texture, model.texture_width, model.texture_height)?;
+    #[cfg(feature = "spot-textured")]
+    {
+        let attributes = ColorUv {
+            color: MeshColors::Uniform(Rgb888::WHITE),
+            uvs: model.uvs,
+        };
+        return Ok(d.draw(&mesh(model, attributes), Textured { texture }));
+    }
+    #[cfg(feature = "spot-textured-lit")]
+    {
+        let lighting = lighting()?;
+        let attributes = ColorUv {
+            color: LitColors {
+                base: MeshColors::Uniform(Rgb888::WHITE),
+                normals: model.normals,
+                lighting: &lighting,
+                material: MATERIAL,
+            },
+            uvs: model.uvs,
+        };
+        return Ok(d.draw(&mesh(model, attributes), Textured { texture }));
+    }
+    #[cfg(feature = "spot-phong")]
+    {
+        let lighting = lighting()?;
+        let attributes = ColorUvNormal {
+            color: MeshColors::Uniform(Rgb888::WHITE),
+            uvs: model.uvs,
+            normals: model.normals,
+        };
+        let phong = Phong {
+            lighting: &lighting,
+            material: MATERIAL,
+            texture,
+        };
+        return Ok(d.draw(&mesh(model, attributes), phong));
+    }
+}
