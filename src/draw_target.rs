@@ -254,6 +254,32 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         })
     }
 
+    /// [`StripDrawer::draw_subpixel`] with `N` varyings per vertex coloured
+    /// by `fragment` (see [`crate::shade`] and
+    /// [`StripRenderer::with_shader`]): lit or textured meshes in immediate
+    /// mode.
+    pub fn draw_shaded<T, F, Sh, const S: u32, const N: usize>(
+        &mut self,
+        target: &mut T,
+        config: Config,
+        fragment: Sh,
+        mut scene: F,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: DrawTarget,
+        T::Color: From<P>,
+        Sh: crate::shade::FragmentShader<N> + Copy,
+        F: FnMut(&mut StripRenderer<'_, P, D::Rows, S, N, Sh>),
+    {
+        self.for_each_strip(target, config, |y0, y1, color, depth| {
+            let mut strip = StripRenderer::<P, D::Rows, S, N, Sh>::with_shader(
+                config, y0, y1, color, depth, fragment,
+            )?;
+            scene(&mut strip);
+            Ok(strip.render_stats())
+        })
+    }
+
     /// Renders a set-up [`Frame`] strip by strip into `target` (see
     /// [`Frame::render_rows`]).
     pub fn draw_frame<T, const S: u32>(
@@ -458,6 +484,20 @@ mod tests {
             let mut display = MockDisplay::<P>::new();
             drawer.draw_frame(&mut display, &frame).unwrap();
             display.assert_eq_with_message(&expected, |f| write!(f, "frame, {rows} rows"));
+
+            // The shaded entry points with the default shader: the same.
+            let mut display = MockDisplay::<P>::new();
+            drawer
+                .draw_shaded::<_, _, _, 8, 3>(&mut display, config(), crate::VertexColor, |strip| {
+                    scene(|p, c, id| strip.submit_clip_triangle(p, c, id).unwrap())
+                })
+                .unwrap();
+            display.assert_eq_with_message(&expected, |f| write!(f, "shaded, {rows} rows"));
+            let mut display = MockDisplay::<P>::new();
+            drawer
+                .draw_frame_shaded(&mut display, &frame, &crate::VertexColor)
+                .unwrap();
+            display.assert_eq_with_message(&expected, |f| write!(f, "shaded frame, {rows} rows"));
         }
     }
 
