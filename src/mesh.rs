@@ -100,6 +100,73 @@ impl BoundingSphere {
     }
 }
 
+impl BoundingSphere {
+    /// Whether every point of the sphere lies in front of the eye and
+    /// wholly above the NDC row `top` or wholly below `bottom` (a strip
+    /// renderer's slab), so that the per-triangle strip test would skip
+    /// every triangle of the object: the object is skipped before any
+    /// vertex is transformed.
+    ///
+    /// Conservative for every finite input, as
+    /// [`BoundingSphere::outside_frustum`]: a vertex's computed `y` and
+    /// `w` each err by at most `γ3 Σ_j |m_rj| |p_j|`, and the per-triangle
+    /// test's product `w * top` adds one rounding; the object is skipped
+    /// only if the exact plane value, minus the sphere's reach, exceeds
+    /// that bound (and likewise `w` stays positive), with the same factor
+    /// of 5 (not 4) covering the `f64` evaluation.
+    pub fn outside_slab(&self, mvp: &Mat4, top: f32, bottom: f32) -> bool {
+        let m = mvp.rows();
+        let c = [
+            self.center.x as f64,
+            self.center.y as f64,
+            self.center.z as f64,
+            1.0,
+        ];
+        let r = self.radius as f64;
+        if !(r >= 0.0
+            && c.iter().all(|v| v.is_finite())
+            && mvp.is_finite()
+            && top.is_finite()
+            && bottom.is_finite())
+        {
+            return false;
+        }
+        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
+        let gamma = 5.0 / 16_777_216.0;
+        let row_err = |i: usize| -> f64 {
+            (0..4)
+                .map(|j| (m[i][j] as f64).abs() * p_abs[j])
+                .sum::<f64>()
+                * gamma
+        };
+        // Whether the plane `a` exceeds `err` everywhere in the sphere:
+        // `a(c) - err > r |n|`, compared squared (no square root in
+        // `no_std`), with the margin of the comparison's rounding.
+        let beyond = |a: [f64; 4], err: f64| -> bool {
+            let at_c: f64 = (0..4).map(|j| a[j] * c[j]).sum();
+            let n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+            let t = at_c - err;
+            t > 0.0 && t * t > r * r * n2 * (1.0 + 1e-9)
+        };
+        let w_row: [f64; 4] = core::array::from_fn(|j| m[3][j] as f64);
+        let (ew, ey) = (row_err(3), row_err(1));
+        // In front of the eye everywhere (the per-triangle test needs w > 0).
+        if !beyond(w_row, ew) {
+            return false;
+        }
+        let w_max: f64 = (0..4).map(|j| w_row[j].abs() * p_abs[j]).sum();
+        for (t, sign) in [(top as f64, 1.0f64), (bottom as f64, -1.0)] {
+            // sign * (y - t w) > 0 everywhere, beyond the rounding bound.
+            let plane: [f64; 4] = core::array::from_fn(|j| sign * (m[1][j] as f64 - t * w_row[j]));
+            let err = ey + t.abs() * (ew + w_max * gamma);
+            if beyond(plane, err) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
 /// Per-triangle or per-vertex colours of a [`Mesh`].
 #[derive(Clone, Copy, Debug)]
 pub enum MeshColors<'a> {

@@ -287,25 +287,39 @@ fn check_mesh_len(n: usize) -> Result<u64, Error> {
     }
 }
 
-/// The bounding-sphere test of a mesh: counts the whole mesh and returns
-/// `true` if it is culled.
+/// The bounding-sphere test of a mesh: against the frustum, and for a
+/// strip renderer against its strip; counts the whole mesh (as
+/// `culled_object` or `outside_strip`) and returns `true` if it is
+/// skipped.
 fn culled_object<K: ?Sized, A>(
     parts: &mut Parts<'_, K>,
     mesh: &Mesh<'_, A>,
     mvp: &Mat4,
     n: u64,
 ) -> bool {
-    match mesh.bounds {
-        Some(b) if b.outside_frustum(mvp) => {
+    let Some(b) = mesh.bounds else {
+        return false;
+    };
+    if b.outside_frustum(mvp) {
+        *parts.stats += Stats {
+            submitted: n,
+            culled_object: n,
+            ..Stats::default()
+        };
+        return true;
+    }
+    // A strip renderer skips an object wholly above or below its strip.
+    if let Some((top, bottom)) = parts.stage.slab {
+        if b.outside_slab(mvp, top, bottom) {
             *parts.stats += Stats {
                 submitted: n,
-                culled_object: n,
+                outside_strip: n,
                 ..Stats::default()
             };
-            true
+            return true;
         }
-        _ => false,
     }
+    false
 }
 
 /// One submission, run once to count (if it might not fit) and once to

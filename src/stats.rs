@@ -37,7 +37,10 @@ pub struct Stats {
     /// Set-up triangles stored or drawn (pieces, after clipping).
     pub stored: u64,
     /// [`StripRenderer`](crate::StripRenderer) only: skipped before any
-    /// setup because the triangle lies wholly above or below the strip.
+    /// setup because the triangle lies wholly above or below the strip,
+    /// one by one or with its whole mesh (whose bounding sphere does,
+    /// [`BoundingSphere::outside_slab`](crate::BoundingSphere::outside_slab):
+    /// then no vertex was transformed).
     pub outside_strip: u64,
 }
 

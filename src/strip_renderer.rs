@@ -11,7 +11,10 @@
 //! is the same code in the same order, only without the store. Triangles
 //! wholly above or below the strip are skipped before clipping and setup
 //! (counted in [`Stats::outside_strip`]), so each strip pays the full
-//! pipeline only for the triangles that reach it.
+//! pipeline only for the triangles that reach it; a mesh whose bounding
+//! sphere lies wholly above or below the strip is skipped before any of
+//! its vertices is transformed (conservatively: no triangle of it could
+//! be stored there).
 
 use crate::color::PixelFormat;
 use crate::config::{check_rows, check_size, Config, Error};

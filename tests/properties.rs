@@ -1044,6 +1044,48 @@ proptest! {
         let (with, stats) = draw(&mesh);
         prop_assert_eq!(&with, &without, "culled_object {}", stats.culled_object);
     }
+
+    /// A strip renderer skips an object whose sphere lies wholly above or
+    /// below its strip, and only one of which no triangle would be stored
+    /// there: the strip's pixels are the same with and without the sphere.
+    #[test]
+    fn bounding_sphere_strip_skip_never_changes_a_strip(
+        (positions, eye, target, fov, near) in object_scene(),
+        y0 in 0u32..48,
+        rows in 1u32..12,
+    ) {
+        let n = positions.len() as u32;
+        let y1 = (y0 + rows).min(48);
+        let indices = (1..n - 1).map(|i| [0, i, i + 1]).collect::<Vec<_>>();
+        let mvp = Mat4::perspective(fov, 1.0, near, near * 1e5)
+            * Mat4::look_at(eye, target, Vec3::new(0.0, 1.0, 0.0));
+        prop_assume!(mvp.is_finite());
+        let mut mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            attributes: MeshColors::Uniform(Rgb888::new(7, 8, 9)),
+            bounds: None,
+        };
+        let len = (48 * (y1 - y0)) as usize;
+        let draw = |mesh: &Mesh<'_>| {
+            let mut ids = vec![TriangleId(0); len];
+            let mut nd = NoDepth;
+            let mut strip =
+                StripRenderer::new(config_nocull(48, 48), y0, y1, &mut ids, &mut nd).unwrap();
+            strip.submit_mesh(mesh, &mvp, 0).unwrap();
+            let stats = strip.stats();
+            (ids, stats)
+        };
+        let (without, plain) = draw(&mesh);
+        mesh.bounds = BoundingSphere::from_points(&positions);
+        let (with, stats) = draw(&mesh);
+        prop_assert_eq!(&with, &without);
+        if stats.outside_strip == indices.len() as u64 && stats.culled_object == 0 {
+            prop_assert_eq!(plain.stored, 0, "skipped an object with a triangle in the strip");
+        } else {
+            prop_assert_eq!(stats.stored, plain.stored);
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -1102,6 +1144,39 @@ proptest! {
                 prop_assume!(snap_tri::<4>(&pos, w, h) == Some(vs));
                 check_coverage::<4>(config_nocull(w, h), pos)?;
             }
+        }
+    }
+}
+
+/// The strip skip fires: an object in the top rows is skipped whole by a
+/// strip at the bottom (counted as outside the strip), and drawn by a
+/// strip it reaches.
+#[test]
+fn an_object_above_the_strip_is_skipped_whole() {
+    let positions: Vec<Vec3> = (0..8)
+        .map(|i| Vec3::new((i % 4) as f32 * 0.2 - 0.3, 0.7 + (i / 4) as f32 * 0.1, 0.0))
+        .collect();
+    let indices: Vec<[u32; 3]> = (1..7).map(|i| [0, i, i + 1]).collect();
+    let mesh = Mesh {
+        positions: &positions,
+        indices: &indices,
+        attributes: MeshColors::Uniform(Rgb888::new(7, 8, 9)),
+        bounds: BoundingSphere::from_points(&positions),
+    };
+    let mvp = Mat4::translation(Vec3::new(0.0, 0.0, -0.5));
+    for (y0, y1, skipped) in [(40u32, 48u32, true), (0, 10, false)] {
+        let mut ids = vec![TriangleId(0); (48 * (y1 - y0)) as usize];
+        let mut nd = NoDepth;
+        let mut strip =
+            StripRenderer::new(config_nocull(48, 48), y0, y1, &mut ids, &mut nd).unwrap();
+        strip.submit_mesh(&mesh, &mvp, 0).unwrap();
+        let s = strip.stats();
+        assert_eq!(s.submitted, 6);
+        if skipped {
+            assert_eq!(s.outside_strip, 6, "{s:?}");
+            assert_eq!(s.culled_object, 0);
+        } else {
+            assert!(s.stored > 0, "{s:?}");
         }
     }
 }
