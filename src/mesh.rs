@@ -64,19 +64,10 @@ impl BoundingSphere {
     /// bound's factor of 4 (not 3).
     pub fn outside_frustum(&self, mvp: &Mat4) -> bool {
         let m = mvp.rows();
-        let c = [
-            self.center.x as f64,
-            self.center.y as f64,
-            self.center.z as f64,
-            1.0,
-        ];
-        let r = self.radius as f64;
-        if !(r >= 0.0 && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
+        let Some((c, r, p_abs)) = self.in_f64(mvp) else {
             return false;
-        }
-        // |p_j| bound inside the sphere.
-        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
-        let gamma = 5.0 / 16_777_216.0;
+        };
+        let gamma = GAMMA;
         for i in 0..3 {
             for sign in [1.0f64, -1.0] {
                 // Plane: row3 + sign * row_i (Gribb-Hartmann), exact in f64.
@@ -100,7 +91,28 @@ impl BoundingSphere {
     }
 }
 
+/// The rounding bound of the vertex stage's rows (`γ3` and the margin of
+/// the `f64` evaluation, see [`BoundingSphere::outside_frustum`]).
+const GAMMA: f64 = 5.0 / 16_777_216.0;
+
 impl BoundingSphere {
+    /// The centre (homogeneous, in `f64`), the radius and the bound
+    /// `|p_j| <= |c_j| + r` on the coordinates of the sphere's points; `None`
+    /// unless the sphere and `mvp` are finite (then nothing is culled).
+    fn in_f64(&self, mvp: &Mat4) -> Option<([f64; 4], f64, [f64; 4])> {
+        let c = [
+            self.center.x as f64,
+            self.center.y as f64,
+            self.center.z as f64,
+            1.0,
+        ];
+        let r = self.radius as f64;
+        if !(r >= 0.0 && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
+            return None;
+        }
+        Some((c, r, [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0]))
+    }
+
     /// Whether every point of the sphere lies in front of the eye and
     /// wholly above the NDC row `top` or wholly below `bottom` (a strip
     /// renderer's slab), so that the per-triangle strip test would skip
@@ -116,23 +128,13 @@ impl BoundingSphere {
     /// of 5 (not 4) covering the `f64` evaluation.
     pub fn outside_slab(&self, mvp: &Mat4, top: f32, bottom: f32) -> bool {
         let m = mvp.rows();
-        let c = [
-            self.center.x as f64,
-            self.center.y as f64,
-            self.center.z as f64,
-            1.0,
-        ];
-        let r = self.radius as f64;
-        if !(r >= 0.0
-            && c.iter().all(|v| v.is_finite())
-            && mvp.is_finite()
-            && top.is_finite()
-            && bottom.is_finite())
-        {
+        let Some((c, r, p_abs)) = self.in_f64(mvp) else {
+            return false;
+        };
+        if !(top.is_finite() && bottom.is_finite()) {
             return false;
         }
-        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
-        let gamma = 5.0 / 16_777_216.0;
+        let gamma = GAMMA;
         let row_err = |i: usize| -> f64 {
             (0..4)
                 .map(|j| (m[i][j] as f64).abs() * p_abs[j])

@@ -37,8 +37,9 @@ use microraster::shade::{
     NoTexture, Phong, Texture, Textured, Wrap,
 };
 use microraster::{
-    Attributes, BoundingSphere, Config, Error, FragmentShader, Frame, Mat4, Mesh, MeshColors,
-    NoDepth, PixelFormat, ProcessedVertex, SetupTriangle, Stats, TriangleId, Vec3, VertexColor,
+    Attributes, BoundingSphere, Config, DepthWord, Error, FragmentShader, Frame, Mat4, Mesh,
+    MeshColors, NoDepth, PixelFormat, ProcessedVertex, SetupTriangle, Stats, TriangleId, Vec3,
+    VertexColor,
 };
 use std::time::Instant;
 
@@ -407,105 +408,71 @@ where
     C: PixelFormat + Send + Sync,
     F: FragmentShader<N> + Sync,
 {
-    let width = frame.config().width as usize;
     let len = color.len();
-    let strip = |y0: u32, c: &mut [C], d: Option<&mut [u32]>| -> Result<u64, Error> {
-        c.fill(clear);
-        let y1 = y0 + (c.len() / width) as u32;
-        Ok(match d {
-            Some(d) => {
-                d.fill(u32::MAX);
-                frame.render_rows_shaded(y0, y1, c, d, fragment)?
-            }
-            None => frame.render_rows_shaded(y0, y1, c, &mut NoDepth, fragment)?,
-        }
-        .pixels_written)
-    };
-    let strip16 = |y0: u32, c: &mut [C], d: Option<&mut [u16]>| -> Result<u64, Error> {
-        c.fill(clear);
-        let y1 = y0 + (c.len() / width) as u32;
-        Ok(match d {
-            Some(d) => {
-                d.fill(u16::MAX);
-                frame.render_rows_shaded(y0, y1, c, d, fragment)?
-            }
-            None => frame.render_rows_shaded(y0, y1, c, &mut NoDepth, fragment)?,
-        }
-        .pixels_written)
-    };
-    let rows = rows as usize;
-    let e = |e: Error| e.to_string();
     Ok(match kind {
         DepthKind::U16 => {
             let mut d = vec![u16::MAX; len];
-            let px = for_each_strip(color, Some(&mut d[..]), width, rows, threads, strip16)
-                .map_err(e)?;
+            let px = draw_with(
+                frame,
+                color,
+                Some(&mut d[..]),
+                clear,
+                rows,
+                threads,
+                fragment,
+            )?;
             (DepthImage::U16(d), px)
         }
         DepthKind::U32 => {
             let mut d = vec![u32::MAX; len];
-            let px =
-                for_each_strip(color, Some(&mut d[..]), width, rows, threads, strip).map_err(e)?;
+            let px = draw_with(
+                frame,
+                color,
+                Some(&mut d[..]),
+                clear,
+                rows,
+                threads,
+                fragment,
+            )?;
             (DepthImage::U32(d), px)
         }
         DepthKind::None => {
             let px =
-                for_each_strip::<C, u32, _>(color, None, width, rows, threads, strip).map_err(e)?;
+                draw_with::<S, N, C, F, u32>(frame, color, None, clear, rows, threads, fragment)?;
             (DepthImage::None, px)
         }
     })
 }
 
-/// Area-weighted smooth normals per vertex, accumulated per position value
-/// (so vertices duplicated at texture seams get the same normal); a vertex
-/// whose sum is zero or not finite gets +z. Returns the normals and how
-/// many needed that fallback.
-pub fn smooth_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> (Vec<Vec3>, usize) {
-    use std::collections::HashMap;
-    let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-    let mut slot: HashMap<[u32; 3], usize> = HashMap::new();
-    let ids: Vec<usize> = positions
-        .iter()
-        .map(|&p| {
-            let n = slot.len();
-            *slot.entry(key(p)).or_insert(n)
-        })
-        .collect();
-    let mut sum = vec![[0.0f64; 3]; slot.len()];
-    for t in indices {
-        let (Some(&a), Some(&b), Some(&c)) = (
-            positions.get(t[0] as usize),
-            positions.get(t[1] as usize),
-            positions.get(t[2] as usize),
-        ) else {
-            continue;
-        };
-        let n = (b - a).cross(c - a);
-        if !n.is_finite() {
-            continue;
-        }
-        for &k in t {
-            let s = &mut sum[ids[k as usize]];
-            s[0] += n.x as f64;
-            s[1] += n.y as f64;
-            s[2] += n.z as f64;
-        }
-    }
-    let mut fallback = 0;
-    let normals = ids
-        .iter()
-        .map(|&i| {
-            let s = sum[i];
-            let l = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-            if l > 0.0 && l.is_finite() {
-                Vec3::new((s[0] / l) as f32, (s[1] / l) as f32, (s[2] / l) as f32)
-            } else {
-                fallback += 1;
-                Vec3::new(0.0, 0.0, 1.0)
+/// [`draw`] into a depth buffer of `T` words (or none).
+fn draw_with<const S: u32, const N: usize, C, F, T>(
+    frame: &Frame<'_, S, N>,
+    color: &mut [C],
+    depth: Option<&mut [T]>,
+    clear: C,
+    rows: u32,
+    threads: usize,
+    fragment: &F,
+) -> Result<u64, String>
+where
+    C: PixelFormat + Send + Sync,
+    F: FragmentShader<N> + Sync,
+    T: DepthWord,
+{
+    let width = frame.config().width as usize;
+    let strip = |y0: u32, c: &mut [C], d: Option<&mut [T]>| -> Result<u64, Error> {
+        c.fill(clear);
+        let y1 = y0 + (c.len() / width) as u32;
+        Ok(match d {
+            Some(d) => {
+                d.fill(T::FAR);
+                frame.render_rows_shaded(y0, y1, c, d, fragment)?
             }
-        })
-        .collect();
-    (normals, fallback)
+            None => frame.render_rows_shaded(y0, y1, c, &mut NoDepth, fragment)?,
+        }
+        .pixels_written)
+    };
+    for_each_strip(color, depth, width, rows as usize, threads, strip).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -520,8 +487,7 @@ mod tests {
             Vec3::new(-1.0, 1.0, 0.0),
         ];
         let indices = vec![[0, 1, 2], [0, 2, 3]];
-        let (normals, fallback) = smooth_normals(&positions, &indices);
-        assert_eq!(fallback, 0);
+        let normals = vec![Vec3::new(0.0, 0.0, 1.0); 4];
         ShadedModel {
             positions,
             indices,
@@ -598,20 +564,5 @@ mod tests {
         };
         let e = render_shaded(&quad(), &CAMERA, &opts(1, 8), &s).unwrap_err();
         assert!(e.contains("--light"), "{e}");
-    }
-
-    #[test]
-    fn seams_share_normals() {
-        // Two copies of one corner (a texture seam) get the same normal.
-        let positions = vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 0.0, 1.0),
-        ];
-        let (n, _) = smooth_normals(&positions, &[[0, 1, 2], [3, 4, 1]]);
-        assert_eq!(n[0], n[3]);
-        assert!((n[0].length() - 1.0).abs() < 1e-5);
     }
 }
