@@ -228,6 +228,10 @@ impl Material {
 /// component first, so no finite non-zero vector under- or overflows.
 #[inline]
 fn normalize(v: Vec3) -> Option<Vec3> {
+    // (`f32::max` below would drop a NaN component.)
+    if !v.is_finite() {
+        return None;
+    }
     let n2 = v.dot(v);
     if n2 > 1e-30 && n2 < 1e30 {
         let inv = 1.0 / fx::sqrt(n2);
@@ -853,6 +857,25 @@ mod tests {
             let l = Lighting::new([0.1; 3], &[sun], d).unwrap();
             let n = l.lights[0].l;
             assert!((n.dot(n) - 1.0).abs() < 1e-5, "{d:?}: {n:?}");
+        }
+        // Found by fuzzing (fuzz/findings/lighting-nan-*): a NaN next to a
+        // finite component is refused, in a light and in the view.
+        for d in [
+            Vec3::new(1.0, f32::NAN, 0.0),
+            Vec3::new(-30000.0, -385.85938, f32::NAN),
+            Vec3::new(-2.95e20, -1e5, f32::NAN),
+            Vec3::new(f32::INFINITY, 0.0, 1.0),
+        ] {
+            let sun = DirectionalLight {
+                direction: d,
+                color: [1.0; 3],
+            };
+            let up = Vec3::new(0.0, 0.0, 1.0);
+            assert_eq!(Lighting::new([0.1; 3], &[], d), Err(Error::InvalidLighting));
+            assert_eq!(
+                Lighting::new([0.1; 3], &[sun], up),
+                Err(Error::InvalidLighting)
+            );
         }
     }
 
