@@ -19,10 +19,6 @@
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
 #   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
-#   MICRORASTER_FUZZ_ALLOW=nonfinite-varyings,lighting-range bash .ci/fuzz.sh
-#                                         # fuzz past known findings (see
-#                                         # fuzz/src/shading.rs `allowed`);
-#                                         # unset in CI: every check strict
 #
 # Reproduce a crash:
 #   cd fuzz && cargo +nightly fuzz run -O -a <target> <file>
