@@ -8,8 +8,12 @@
 # `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
 # Targets: frame, strip_renderer, shading (every shading: colours, lit
 # colours, textures, Phong; ids, depth and counters independent of it).
+# Before fuzzing, every file in fuzz/findings/ (minimised inputs of fixed
+# core issues, README.md there; the .md files skipped) is replayed once
+# through each target on each build, every check strict: a regression.
 # Exits non-zero when a target crashes (panic, overflow, assertion, ASan
-# report); the crashing input is left in fuzz/artifacts/<target>/.
+# report) or a finding replays to a crash; the crashing input is left in
+# fuzz/artifacts/<target>/.
 #
 #   bash .ci/fuzz.sh                      # CI: a minute per target
 #                                         # (40 s libm build, 20 s micromath)
@@ -68,6 +72,31 @@ for b in $BUILDS; do
 done
 mkdir -p target/logs
 status=0
+# Findings first: libFuzzer runs each file given as an argument once.
+findings=()
+for f in findings/*; do
+  case "$f" in *.md) ;; *) [ -f "$f" ] && findings+=("$f") ;; esac
+done
+if [ "${#findings[@]}" -gt 0 ]; then
+  for t in $TARGETS; do
+    for b in $BUILDS; do
+      log="target/logs/$t-$b-findings.log"
+      set +e
+      # shellcheck disable=SC2046
+      cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "${findings[@]}" -- \
+        -rss_limit_mb=4096 -timeout=30 >"$log" 2>&1
+      rc=$?
+      set -e
+      if [ "$rc" -ne 0 ]; then
+        echo "!! $t ($b build): a finding fails again (exit $rc); the end of $log:"
+        tail -n 40 "$log"
+        status=1
+      else
+        echo "ok: $t ($b build) replays the ${#findings[@]} findings clean"
+      fi
+    done
+  done
+fi
 for t in $TARGETS; do
   mkdir -p "corpus/$t"
   if [ -d "seeds/$t" ]; then
