@@ -72,31 +72,31 @@ for b in $BUILDS; do
 done
 mkdir -p target/logs
 status=0
-# Findings first: libFuzzer runs each file given as an argument once.
-findings=()
-for f in findings/*; do
-  case "$f" in *.md) ;; *) [ -f "$f" ] && findings+=("$f") ;; esac
-done
-if [ "${#findings[@]}" -gt 0 ]; then
-  for t in $TARGETS; do
-    for b in $BUILDS; do
-      log="target/logs/$t-$b-findings.log"
+# Findings first, one run per file (libFuzzer runs a file given as an
+# argument once; it would stop at the first that fails).
+for t in $TARGETS; do
+  for b in $BUILDS; do
+    n=0
+    for f in findings/*; do
+      case "$f" in *.md) continue ;; esac
+      [ -f "$f" ] || continue
+      n=$((n + 1))
+      log="target/logs/$t-$b-finding-$(basename "$f").log"
       set +e
       # shellcheck disable=SC2046
-      cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "${findings[@]}" -- \
+      cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "$f" -- \
         -rss_limit_mb=4096 -timeout=30 >"$log" 2>&1
       rc=$?
       set -e
       if [ "$rc" -ne 0 ]; then
-        echo "!! $t ($b build): a finding fails again (exit $rc); the end of $log:"
-        tail -n 40 "$log"
+        echo "!! $t ($b build): finding $f fails (exit $rc); from $log:"
+        grep -A2 -m1 'panicked at\|ERROR: ' "$log" || tail -n 20 "$log"
         status=1
-      else
-        echo "ok: $t ($b build) replays the ${#findings[@]} findings clean"
       fi
     done
+    echo "== $t ($b build): $n findings replayed"
   done
-fi
+done
 for t in $TARGETS; do
   mkdir -p "corpus/$t"
   if [ -d "seeds/$t" ]; then
