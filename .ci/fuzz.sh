@@ -8,8 +8,14 @@
 # `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
 # Targets: frame, strip_renderer, shading (every shading: colours, lit
 # colours, textures, Phong; ids, depth and counters independent of it).
+# Before fuzzing, every file in fuzz/findings/ (minimised inputs of core
+# issues, README.md there; the .md files skipped) is replayed once through
+# each target on each build, every check strict unless
+# MICRORASTER_FUZZ_ALLOW relaxes one: a fixed one failing is a regression,
+# an open one fails until the core is fixed.
 # Exits non-zero when a target crashes (panic, overflow, assertion, ASan
-# report); the crashing input is left in fuzz/artifacts/<target>/.
+# report) or a finding replays to a crash; the crashing input is left in
+# fuzz/artifacts/<target>/.
 #
 #   bash .ci/fuzz.sh                      # CI: a minute per target
 #                                         # (40 s libm build, 20 s micromath)
@@ -19,8 +25,9 @@
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
 #   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
-#   MICRORASTER_FUZZ_ALLOW=nonfinite-varyings,lighting-range bash .ci/fuzz.sh
-#                                         # fuzz past known findings (see
+#   MICRORASTER_FUZZ_ALLOW=lighting-nan bash .ci/fuzz.sh
+#                                         # fuzz past an open finding (see
+#                                         # fuzz/findings/README.md and
 #                                         # fuzz/src/shading.rs `allowed`);
 #                                         # unset in CI: every check strict
 #
@@ -72,6 +79,31 @@ for b in $BUILDS; do
 done
 mkdir -p target/logs
 status=0
+# Findings first, one run per file (libFuzzer runs a file given as an
+# argument once; it would stop at the first that fails).
+for t in $TARGETS; do
+  for b in $BUILDS; do
+    n=0
+    for f in findings/*; do
+      case "$f" in *.md) continue ;; esac
+      [ -f "$f" ] || continue
+      n=$((n + 1))
+      log="target/logs/$t-$b-finding-$(basename "$f").log"
+      set +e
+      # shellcheck disable=SC2046
+      cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "$f" -- \
+        -rss_limit_mb=4096 -timeout=30 >"$log" 2>&1
+      rc=$?
+      set -e
+      if [ "$rc" -ne 0 ]; then
+        echo "!! $t ($b build): finding $f fails (exit $rc); from $log:"
+        grep -A2 -m1 'panicked at\|ERROR: ' "$log" || tail -n 20 "$log"
+        status=1
+      fi
+    done
+    echo "== $t ($b build): $n findings replayed"
+  done
+done
 for t in $TARGETS; do
   mkdir -p "corpus/$t"
   if [ -d "seeds/$t" ]; then
