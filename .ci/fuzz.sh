@@ -8,11 +8,9 @@
 # `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
 # Targets: frame, strip_renderer, shading (every shading: colours, lit
 # colours, textures, Phong; ids, depth and counters independent of it).
-# Before fuzzing, every file in fuzz/findings/ (minimised inputs of core
-# issues, README.md there; the .md files skipped) is replayed once through
-# each target on each build, every check strict unless
-# MICRORASTER_FUZZ_ALLOW relaxes one: a fixed one failing is a regression,
-# an open one fails until the core is fixed.
+# Before fuzzing, every file in fuzz/findings/ (minimised inputs of fixed
+# core issues, README.md there; the .md files skipped) is replayed once
+# through each target on each build, every check strict: a regression.
 # Exits non-zero when a target crashes (panic, overflow, assertion, ASan
 # report) or a finding replays to a crash; the crashing input is left in
 # fuzz/artifacts/<target>/.
@@ -25,11 +23,6 @@
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
 #   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
-#   MICRORASTER_FUZZ_ALLOW=lighting-nan bash .ci/fuzz.sh
-#                                         # fuzz past an open finding (see
-#                                         # fuzz/findings/README.md and
-#                                         # fuzz/src/shading.rs `allowed`);
-#                                         # unset in CI: every check strict
 #
 # Reproduce a crash:
 #   cd fuzz && cargo +nightly fuzz run -O -a <target> <file>

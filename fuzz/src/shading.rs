@@ -687,21 +687,6 @@ fn ok_direction(v: [f32; 3]) -> bool {
     v.iter().all(|c| c.is_finite()) && v.iter().any(|&c| c != 0.0)
 }
 
-/// Known findings the harness relaxes, by name, only when listed in the
-/// environment variable `MICRORASTER_FUZZ_ALLOW` (comma-separated), to
-/// fuzz past them while the core is being fixed; by default (CI) every
-/// check is strict. Names: `lighting-nan` (`Lighting::new` accepts a
-/// direction or view with a NaN component next to a finite non-zero one,
-/// `fuzz/findings/README.md`: such an `Ok` is not asserted against, and
-/// the lighting is used).
-pub fn allowed(name: &str) -> bool {
-    static ALLOW: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    ALLOW
-        .get_or_init(|| std::env::var("MICRORASTER_FUZZ_ALLOW").unwrap_or_default())
-        .split(',')
-        .any(|a| a.trim() == name)
-}
-
 fn run_s<const S: u32, T: Texel + core::fmt::Debug>(
     input: &ShadeInput,
     ctx: &Ctx,
@@ -777,16 +762,10 @@ fn run_s<const S: u32, T: Texel + core::fmt::Debug>(
         && lights
             .iter()
             .all(|l| ok_direction([l.direction.x, l.direction.y, l.direction.z]) && fin(&l.color));
-    let nan = |v: [f32; 3]| v.iter().any(|c| c.is_nan());
-    let nan_accepted = allowed("lighting-nan")
-        && (nan(view)
-            || lights
-                .iter()
-                .any(|l| nan([l.direction.x, l.direction.y, l.direction.z])));
     let lighting = Lighting::new(ambient, &lights, v3(r.view));
     match &lighting {
         Ok(_) => assert!(
-            light_ok || nan_accepted,
+            light_ok,
             "Lighting::new({ambient:?}, {lights:?}, {view:?}): Ok"
         ),
         Err(e) => {
