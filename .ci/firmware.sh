@@ -206,18 +206,23 @@ for b in "${boards[@]}"; do
   done
 done
 
-# The configuration sweep (cubes, set up once): the axes one at a time
-# from the default S8 u16 libm (subpixel bits 4; depth u32, none; the
-# micromath backend; the i32 edge fast path off), on the M4F and the M0.
+# The configuration sweep (cubes, set up once), on the M4F and the M0:
+# the report's eight configurations (subpixel bits 8 / 4, depth u16 / u32,
+# float backend libm / micromath), and from the default S8 u16 libm no
+# depth buffer and the i32 edge fast path off: 10 per board.
 # "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
-# the default and no-depth runs above are these configurations already.
+# the default and no-depth runs above are two of them already.
 config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
 configs=(
   "S8 u16 libm||depth-u16|default"
   "S4 u16 libm|--features subpixel4|cubes-s4|"
   "S8 u32 libm|--features depth-u32|cubes-u32|"
   "S8 none libm|--features no-depth|no-depth|no-depth"
+  "S4 u32 libm|--features subpixel4,depth-u32|cubes-s4-u32|"
   "S8 u16 micromath|--no-default-features --features micromath|cubes-micromath|"
+  "S4 u16 micromath|--no-default-features --features micromath,subpixel4|cubes-s4-micromath|"
+  "S8 u32 micromath|--no-default-features --features micromath,depth-u32|cubes-u32-micromath|"
+  "S4 u32 micromath|--no-default-features --features micromath,subpixel4,depth-u32|cubes-s4-u32-micromath|"
   "S8 u16 libm no-i32-edges|--features no-i32-edges|depth-u16|"
 )
 config_header="| board | configuration | frame | render | rasterization | RAM B |"
