@@ -96,9 +96,12 @@ compile_error!("`depth-u32` is for the cubes with a depth buffer (not `no-depth`
 const SUBPIXEL: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
 
 /// The depth buffer's word (`depth-u32`: `u32`, else `u16`).
-#[cfg(all(not(feature = "spot"), not(feature = "depth-u32")))]
+#[cfg(not(any(feature = "spot", feature = "no-depth", feature = "depth-u32")))]
 type DepthWord = u16;
-#[cfg(all(not(feature = "spot"), feature = "depth-u32"))]
+#[cfg(all(
+    not(any(feature = "spot", feature = "no-depth")),
+    feature = "depth-u32"
+))]
 type DepthWord = u32;
 
 // BOARD, CORE, STRIP_ROWS and HOST_CHECKSUM, written by build.rs.
