@@ -347,22 +347,22 @@ fn place_point_labels(
     for &((x, y), i) in points {
         let (w, h) = (names[i].len() as i32 * 6, 10);
         let mut candidates = vec![
-            (8, -5),
-            (8, -16),
-            (8, 6),
-            (-8 - w, -5),
-            (-8 - w, -16),
-            (-8 - w, 6),
+            (11, -5),
+            (11, -16),
+            (11, 6),
+            (-11 - w, -5),
+            (-11 - w, -16),
+            (-11 - w, 6),
             (-w / 2, -20),
             (-w / 2, 9),
-            (8, -28),
-            (8, 18),
-            (-8 - w, -28),
-            (-8 - w, 18),
-            (8, -40),
-            (8, 30),
+            (11, -28),
+            (11, 18),
+            (-11 - w, -28),
+            (-11 - w, 18),
+            (11, -40),
+            (11, 30),
         ];
-        for dx in [8, -8 - w, -w / 2, 24, -24 - w] {
+        for dx in [11, -11 - w, -w / 2, 24, -24 - w] {
             for k in 1..60 {
                 candidates.push((dx, -5 - 11 * k));
                 candidates.push((dx, -5 + 11 * k));
@@ -375,7 +375,12 @@ fn place_point_labels(
         let pick = candidates
             .iter()
             .map(|&c| rect_at(c))
-            .find(|r| inside(r) && !taken.iter().any(|t| overlaps(r, t)))
+            .find(|r| {
+                // A gap of a few pixels between labels, so that two never
+                // read as one.
+                let padded = (r.0 - 4, r.1 - 1, r.2 + 4, r.3 + 1);
+                inside(r) && !taken.iter().any(|t| overlaps(&padded, t))
+            })
             .unwrap_or_else(|| rect_at(candidates[0]));
         taken.push(pick);
         labels.push(Label {
