@@ -12,7 +12,10 @@
 # same for baked, textured, lit Spot in its six shading variants (after
 # checking that the committed bakes are what `microraster bake` writes,
 # and that the unlit and untextured variants link no lighting or texture
-# code), with its own table.
+# code), with its own table. Then the configuration sweep of the cubes on
+# the M4F and the M0 (subpixel bits, depth buffer, float backend, the i32
+# edge fast path: the speed axis of `microraster report speed-vs-error`),
+# with its own table of record.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -53,6 +56,8 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
     cargo clippy -q --release --target "$target" -- -D warnings
     cargo clippy -q --release --target "$target" --features no-depth,flat -- -D warnings
     cargo clippy -q --release --target "$target" --features immediate -- -D warnings
+    cargo clippy -q --release --target "$target" --features subpixel4,depth-u32,no-i32-edges -- -D warnings
+    cargo clippy -q --release --target "$target" --no-default-features --features micromath -- -D warnings
     for v in spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong; do
       cargo clippy -q --release --target "$target" --features "$v" -- -D warnings
     done
@@ -201,6 +206,99 @@ for b in "${boards[@]}"; do
   done
 done
 
+# The configuration sweep (cubes, set up once), on the M4F and the M0:
+# the report's eight configurations (subpixel bits 8 / 4, depth u16 / u32,
+# float backend libm / micromath), and from the default S8 u16 libm no
+# depth buffer and the i32 edge fast path off: 10 per board.
+# "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
+# the default and no-depth runs above are two of them already.
+config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
+configs=(
+  "S8 u16 libm||depth-u16|default"
+  "S4 u16 libm|--features subpixel4|cubes-s4|"
+  "S8 u32 libm|--features depth-u32|cubes-u32|"
+  "S8 none libm|--features no-depth|no-depth|no-depth"
+  "S4 u32 libm|--features subpixel4,depth-u32|cubes-s4-u32|"
+  "S8 u16 micromath|--no-default-features --features micromath|cubes-micromath|"
+  "S4 u16 micromath|--no-default-features --features micromath,subpixel4|cubes-s4-micromath|"
+  "S8 u32 micromath|--no-default-features --features micromath,depth-u32|cubes-u32-micromath|"
+  "S4 u32 micromath|--no-default-features --features micromath,subpixel4,depth-u32|cubes-s4-u32-micromath|"
+  "S8 u16 libm no-i32-edges|--features no-i32-edges|depth-u16|"
+)
+config_header="| board | configuration | frame | render | rasterization | RAM B |"
+config_rows=()
+# check_config BOARD LABEL "frame render raster": the 1 % check of
+# check_counts against docs/embedded.md's configuration table.
+check_config() {
+  local board=$1 name=$2 now=$3 recorded
+  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+    '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $4, $5, $6; exit }' "$record")
+  if [ -z "$recorded" ]; then
+    echo "FAIL: no configuration row for $board $name in docs/embedded.md"
+    return 1
+  fi
+  local labels=(frame render rasterization) i bad=0
+  read -r -a was <<<"$recorded"
+  read -r -a is <<<"$now"
+  for i in 0 1 2; do
+    if [ $(( is[i] * 100 )) -gt $(( was[i] * (100 + tolerance_pct) )) ] && [ $(( is[i] - was[i] )) -gt "$slack" ]; then
+      echo "FAIL: $board $name ${labels[i]} ${is[i]} instructions, over 1.0${tolerance_pct}x the recorded ${was[i]}"
+      bad=1
+    elif [ $(( is[i] * 100 )) -lt $(( was[i] * (100 - tolerance_pct) )) ] && [ $(( was[i] - is[i] )) -gt "$slack" ]; then
+      echo "note: $board $name ${labels[i]} ${is[i]}, below the recorded ${was[i]}: update docs/embedded.md"
+    fi
+  done
+  return "$bad"
+}
+for b in "${config_boards[@]}"; do
+  read -r target board <<<"$b"
+  for c in "${configs[@]}"; do
+    IFS='|' read -r label args key reuse <<<"$c"
+    step "$board ($target), configuration: $label"
+    if [ -n "$reuse" ]; then
+      out=$log/$board-$reuse.txt
+      echo "(the $reuse run above)"
+      if ! grep -q '^PASS' "$out"; then
+        echo "FAIL: $board $label: the $reuse run did not pass"
+        failed=1
+        continue
+      fi
+    else
+      out=$log/$board-config-${label// /-}.txt
+      set +e
+      # shellcheck disable=SC2086 # $args is a list of cargo arguments
+      timeout 900 cargo run -q --release --target "$target" $args </dev/null >"$out" 2>&1
+      rc=$?
+      set -e
+      cat "$out"
+      if [ "$rc" -ne 0 ]; then
+        echo "FAIL: $board $label exited $rc"
+        failed=1
+        continue
+      fi
+    fi
+    got=$(awk '$1 == "checksum" { print $2 }' "$out")
+    want=$(expected "$key")
+    if [ -z "$want" ] || [ "$got" != "$want" ]; then
+      echo "FAIL: $board $label checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
+      failed=1
+    fi
+    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
+    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
+    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
+    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
+    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
+    ram=$((statics + stack))
+    case $board in microbit) budget=16384 ;; *) budget=24576 ;; esac
+    if [ "$ram" -gt "$budget" ]; then
+      echo "FAIL: $board $label uses $ram B of RAM, over the $budget B budget"
+      failed=1
+    fi
+    config_rows+=("| $board | $label | $frame | $render | $raster | $ram |")
+    check_config "$board" "$label" "$frame $render $raster" || failed=1
+  done
+done
+
 spot_rows=()
 for b in "${boards[@]}"; do
   read -r target board <<<"$b"
@@ -258,6 +356,11 @@ step "Spot, shading variants (320x240 Rgb565, u16 depth, immediate; the same tab
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${spot_rows[@]}"
+
+step "configurations, the report's speed axis (cubes, set up once; the same table in docs/embedded.md)"
+echo "$config_header"
+echo "|---|---|---:|---:|---:|---:|"
+printf '%s\n' "${config_rows[@]}"
 
 if [ "$failed" -ne 0 ]; then
   echo

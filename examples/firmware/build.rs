@@ -15,6 +15,13 @@
 //! firmware's: `microraster_scenes::checksum::FrameChecksum` over the
 //! `Rgb565` pixels, rows top to bottom.
 //!
+//! The configuration features (`subpixel4`, `depth-u32`, `micromath`,
+//! `no-i32-edges`) are mirrored: the host frame is a `Frame::<4>` with
+//! `subpixel4`, has a `u32` depth buffer with `depth-u32`, and the core
+//! and scenes crates built here have the firmware's float backend and
+//! edge path (the crate's features enable the same features of the
+//! build-dependencies), so the frame is the same configuration's.
+//!
 //! With a `spot-*` feature the frame is baked Spot instead
 //! (`src/spot_scene.rs`, compiled here too, with the same features): the
 //! whole mesh set up once in a `Frame<8, N>` and rendered with
@@ -77,7 +84,7 @@ struct Board {
 /// mode (`immediate` feature) needs no setup storage, so its strips can
 /// be taller; set-up-once mode keeps the frame's set-up triangles
 /// (`SETUP_CAPACITY` of them, 112 B each) and pays for them in strip rows.
-fn board(target: &str, immediate: bool, spot: bool) -> Board {
+fn board(target: &str, immediate: bool, spot: bool, depth_u32: bool) -> Board {
     let rows = |setup_once: u32, immediate_rows: u32| {
         if spot {
             // Spot: immediate mode, the rows that fit beside the stack
@@ -85,6 +92,27 @@ fn board(target: &str, immediate: bool, spot: bool) -> Board {
             match target {
                 "thumbv6m-none-eabi" => SPOT_ROWS_MICROBIT,
                 _ => SPOT_ROWS_MPS2,
+            }
+        } else if depth_u32 {
+            // A `u32` depth buffer: 1,920 B a row of colour and depth
+            // instead of 1,280, so fewer rows fit the same RAM: 9 on the
+            // MPS2 boards (set up once; 11 immediate), 4 on the micro:bit
+            // (6 immediate).
+            match target {
+                "thumbv6m-none-eabi" => {
+                    if immediate {
+                        6
+                    } else {
+                        4
+                    }
+                }
+                _ => {
+                    if immediate {
+                        11
+                    } else {
+                        9
+                    }
+                }
             }
         } else if immediate {
             immediate_rows
@@ -134,13 +162,18 @@ fn frame_checksum(pixels: &[Rgb565]) -> u64 {
 #[cfg(not(feature = "spot"))]
 fn host_checksum(depth: bool) -> u64 {
     let mut storage = vec![SetupTriangle::EMPTY; cubes::CUBE_INDICES.len() * 4 * 7];
-    let mut frame = Frame::new(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
+    const S: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
+    let mut frame =
+        Frame::<S>::with_subpixel_bits(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
     cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| {
         frame.submit_mesh(mesh, mvp, id).unwrap()
     });
     let n = (WIDTH * HEIGHT) as usize;
     let mut color = vec![Rgb565::BLACK; n];
-    if depth {
+    if depth && cfg!(feature = "depth-u32") {
+        let mut z = vec![u32::MAX; n];
+        frame.render_rows(0, HEIGHT, &mut color, &mut z[..])
+    } else if depth {
         let mut z = vec![u16::MAX; n];
         frame.render_rows(0, HEIGHT, &mut color, &mut z[..])
     } else {
@@ -255,7 +288,8 @@ fn main() {
     if spot && small {
         println!("cargo::rustc-cfg=small_spot");
     }
-    let b = board(&target, immediate, spot);
+    let depth_u32 = env::var_os("CARGO_FEATURE_DEPTH_U32").is_some();
+    let b = board(&target, immediate, spot, depth_u32);
     #[cfg(not(feature = "spot"))]
     let depth = env::var_os("CARGO_FEATURE_NO_DEPTH").is_none();
 

@@ -40,6 +40,14 @@
 //! interpolated colour; each leaves that code out of the binary (see
 //! `docs/embedded.md` for what that saves).
 //!
+//! Configuration features (cubes; the report's speed axis, see
+//! `docs/embedded.md`): `subpixel4` (4 subpixel bits instead of 8, set
+//! up once only), `depth-u32` (a `u32` depth buffer, fewer rows per
+//! strip), `micromath` with `--no-default-features` (the float backend of
+//! the core and the scenes; `libm` is the default) and `no-i32-edges`
+//! (the core's measurement feature: no `i32` edge fast path). build.rs
+//! renders the same configuration on the host.
+//!
 //! Features `spot-flat`, `spot-gouraud`, `spot-lit`, `spot-textured`,
 //! `spot-textured-lit` and `spot-phong` draw baked Spot instead (`spot.rs`,
 //! `spot_scene.rs`): the model and its texture in flash, immediate mode,
@@ -77,6 +85,24 @@ use microraster::{Config, ProcessedVertex, StripDrawer, Submit};
 #[cfg(not(feature = "spot"))]
 use microraster_scenes::cubes;
 use panic_semihosting as _;
+
+#[cfg(all(feature = "subpixel4", any(feature = "immediate", feature = "spot")))]
+compile_error!("`subpixel4` is for the cubes set up once (not `immediate` or `spot-*`)");
+#[cfg(all(feature = "depth-u32", any(feature = "no-depth", feature = "spot")))]
+compile_error!("`depth-u32` is for the cubes with a depth buffer (not `no-depth` or `spot-*`)");
+
+/// Subpixel bits of the frame (`subpixel4`: 4, else 8).
+#[cfg(not(feature = "spot"))]
+const SUBPIXEL: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
+
+/// The depth buffer's word (`depth-u32`: `u32`, else `u16`).
+#[cfg(not(any(feature = "spot", feature = "no-depth", feature = "depth-u32")))]
+type DepthWord = u16;
+#[cfg(all(
+    not(any(feature = "spot", feature = "no-depth")),
+    feature = "depth-u32"
+))]
+type DepthWord = u32;
 
 // BOARD, CORE, STRIP_ROWS and HOST_CHECKSUM, written by build.rs.
 include!(concat!(env!("OUT_DIR"), "/board.rs"));
@@ -146,7 +172,7 @@ type Vertices = [ProcessedVertex; 4 * 8];
 #[cfg(not(feature = "spot"))]
 fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
     // A frame with no storage is enough to run the vertex stage.
-    let probe = microraster::Frame::new(config, &mut []);
+    let probe = microraster::Frame::<SUBPIXEL>::with_subpixel_bits(config, &mut []);
     if let Ok(probe) = probe {
         for (mvp, cache) in mvps.iter().zip(out.chunks_exact_mut(8)) {
             probe.process_vertices(mvp, &cubes::POSITIONS, cache);
@@ -210,7 +236,7 @@ fn main() -> ! {
     #[cfg(not(feature = "immediate"))]
     static mut SETUP: [SetupTriangle; SETUP_CAPACITY] = [SetupTriangle::EMPTY; SETUP_CAPACITY];
     #[cfg(not(feature = "no-depth"))]
-    static mut DEPTH: [u16; STRIP_LEN] = [0; STRIP_LEN];
+    static mut DEPTH: [DepthWord; STRIP_LEN] = [0; STRIP_LEN];
 
     let p = cortex_m::Peripherals::take().unwrap();
     let mut clock = Clock::start(p.SYST);
@@ -240,7 +266,7 @@ fn main() -> ! {
     };
     #[cfg(not(feature = "immediate"))]
     let (drawn, setup_ticks) = {
-        let mut frame = match microraster::Frame::new(config, SETUP) {
+        let mut frame = match microraster::Frame::<SUBPIXEL>::with_subpixel_bits(config, SETUP) {
             Ok(f) => f,
             Err(e) => {
                 hprintln!("FAIL: frame: {}", e);
@@ -280,7 +306,7 @@ fn main() -> ! {
     let t = clock.now();
     COLOR.fill(BLACK);
     #[cfg(not(feature = "no-depth"))]
-    DEPTH.fill(u16::MAX);
+    DEPTH.fill(DepthWord::MAX);
     let clear_ticks = (clock.now() - t) * strips;
     #[cfg(not(feature = "immediate"))]
     let geometry_ticks = setup_ticks;
@@ -314,6 +340,8 @@ fn main() -> ! {
         HEIGHT,
         if cfg!(feature = "no-depth") {
             "none"
+        } else if cfg!(feature = "depth-u32") {
+            "u32"
         } else {
             "u16"
         },
@@ -329,6 +357,20 @@ fn main() -> ! {
         },
         strips,
         STRIP_ROWS,
+    );
+    hprintln!(
+        "configuration: subpixel {}, math {}, i32 edge fast path {}",
+        SUBPIXEL,
+        if cfg!(feature = "libm") {
+            "libm"
+        } else {
+            "micromath"
+        },
+        if cfg!(feature = "no-i32-edges") {
+            "off"
+        } else {
+            "on"
+        },
     );
     hprintln!("checksum {:#018x}", checksum.unwrap_or(0));
     hprintln!("host     {:#018x}", HOST_CHECKSUM);

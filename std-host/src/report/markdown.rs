@@ -14,40 +14,87 @@ pub(crate) fn sci(v: f64) -> String {
     }
 }
 
+/// A count as `798,080`, or `-` where there is none.
+pub(crate) fn thousands(n: Option<u64>) -> String {
+    let Some(n) = n else { return "-".into() };
+    let d = n.to_string();
+    let mut out = String::new();
+    for (i, c) in d.chars().enumerate() {
+        if i > 0 && (d.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// The starred configurations by M4F render count and by host time (see
+/// [`significant_front`]), indices into `summary`.
+pub fn stars(summary: &[Summary]) -> (Vec<usize>, Vec<usize>) {
+    let by_count: Vec<(f64, f64, f64)> = summary
+        .iter()
+        .map(|r| {
+            let (lo, hi) = count_range(r.device.m4f_render);
+            (lo, hi, r.id_diff_pct)
+        })
+        .collect();
+    let by_time: Vec<(f64, f64, f64)> = summary
+        .iter()
+        .map(|r| (r.time_min_ms, r.time_max_ms, r.id_diff_pct))
+        .collect();
+    (significant_front(&by_count), significant_front(&by_time))
+}
+
 /// The report's markdown.
-pub fn markdown(info: &RunInfo, summary: &[Summary], rows: &[Row]) -> String {
+pub fn markdown(
+    info: &RunInfo,
+    summary: &[Summary],
+    rows: &[Row],
+    device: &[firmware::FirmwareRow],
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Speed against error\n");
     let _ = writeln!(
         s,
-        "{}x{} pixels, one thread, median of {} frames per cell; errors against the `f64` \
-         reference renderer (`std-host/src/reference.rs`). Written by \
+        "{}x{} pixels, one thread, median of {} frames per cell (with the fastest and the \
+         slowest); errors against the `f64` reference renderer (`std-host/src/reference.rs`). \
+         Speed of record: the firmware's instructions for the four cubes at 320x240 in the same \
+         configuration on the Cortex-M4F and the Cortex-M0 under QEMU (`docs/embedded.md`, \
+         *Configurations*, measured by `.ci/firmware.sh`). Written by \
          `microraster report speed-vs-error`.\n",
         info.width, info.height, info.reps
     );
     let _ = writeln!(s, "## By configuration (all scenes together)\n");
     let _ = writeln!(
         s,
-        "| configuration | frame time, sum (ms) | pixels differing | coverage only | \
+        "| configuration | ★ M4F | ★ host | M4F render (instr.) | M4F rasterization | \
+         M0 render | M0 rasterization | host frame time, sum (ms): median [min, max] | \
+         pixels differing | coverage only | \
          unexplained | depth max (LSB) | depth beyond bound | depth vs exact, mean | \
          depth vs exact, max | colour max (LSB) | colour beyond bound | matrix error (rel.) | \
          vertex error (px) |"
     );
-    let _ = writeln!(s, "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|");
-    let front = pareto_front(
-        &summary
-            .iter()
-            .map(|r| (r.time_ms, r.id_diff_pct))
-            .collect::<Vec<_>>(),
+    let _ = writeln!(
+        s,
+        "|---|:-:|:-:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
     );
+    let (by_count, by_time) = stars(summary);
+    let star = |front: &[usize], i: usize| if front.contains(&i) { "★" } else { "" };
     for (i, r) in summary.iter().enumerate() {
-        let mark = if front.contains(&i) { " ★" } else { "" };
         let _ = writeln!(
             s,
-            "| {}{} | {:.2} | {:.3} % | {:.3} % | {} | {:.0} | {} | {} | {} | {:.0} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.2} [{:.2}, {:.2}] | {:.3} % | {:.3} % | {} | \
+             {:.0} | {} | {} | {} | {:.0} | {} | {} | {} |",
             r.config.label(),
-            mark,
+            star(&by_count, i),
+            star(&by_time, i),
+            thousands(r.device.m4f_render),
+            thousands(r.device.m4f_raster),
+            thousands(r.device.m0_render),
+            thousands(r.device.m0_raster),
             r.time_ms,
+            r.time_min_ms,
+            r.time_max_ms,
             r.id_diff_pct,
             r.coverage_diff_pct,
             r.unexplained,
@@ -63,12 +110,44 @@ pub fn markdown(info: &RunInfo, summary: &[Summary], rows: &[Row]) -> String {
     }
     let _ = writeln!(
         s,
-        "\n★ on the Pareto front of frame time against pixels differing.\n"
+        "\n★ on the Pareto front of speed against pixels differing, where the lead is larger \
+         than the noise: a configuration is starred only if it is faster, beyond the noise, than \
+         every configuration at least as accurate (the errors are deterministic). *★ M4F*: by the \
+         M4F's render instructions, noise taken as {:.0} % (the SysTick granularity is 40 \
+         instructions a tick on the M4F and 62.5 on the micro:bit, times the strips for the \
+         clears: a few thousand instructions, well under 1 %); *★ host*: by the host time, where \
+         the ranges [min, max] over the repetitions must not overlap.\n",
+        firmware::COUNT_NOISE * 100.0
     );
+    let _ = writeln!(s, "## The firmware's configurations (`docs/embedded.md`)\n");
+    let _ = writeln!(
+        s,
+        "The four cubes, 320x240 `Rgb565`, set up once, under QEMU `-icount shift=0`; \
+         instructions, and RAM in bytes. `none`: no depth buffer; `no-i32-edges`: every triangle \
+         on the `i64` edge path (the core's measurement feature; the same pixels).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| board | configuration | frame | render | rasterization | RAM B |"
+    );
+    let _ = writeln!(s, "|---|---|--:|--:|--:|--:|");
+    for d in device {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} |",
+            d.board,
+            d.config,
+            thousands(Some(d.frame)),
+            thousands(Some(d.render)),
+            thousands(Some(d.raster)),
+            d.ram
+        );
+    }
+    let _ = writeln!(s);
     let _ = writeln!(s, "## By scene\n");
     let _ = writeln!(
         s,
-        "| scene | configuration | time (ms) | covered | differing | coverage only | \
+        "| scene | configuration | time (ms): median [min, max] | covered | differing | coverage only | \
          unexplained | depth max (LSB) | depth mean (LSB) | depth beyond | colour max | \
          colour mean | colour beyond | matrix err | clip err (rel. w) | vertex err (px) | \
          vertex err (z) |"
@@ -81,11 +160,13 @@ pub fn markdown(info: &RunInfo, summary: &[Summary], rows: &[Row]) -> String {
         let e = &r.errors;
         let _ = writeln!(
             s,
-            "| {} | {} | {:.3} | {} | {} | {} | {} | {:.0} | {:.2} | {} | {:.0} | {:.3} | {} | \
+            "| {} | {} | {:.3} [{:.3}, {:.3}] | {} | {} | {} | {} | {:.0} | {:.2} | {} | {:.0} | {:.3} | {} | \
              {} | {} | {} | {} |",
             r.scene,
             r.config.label(),
             r.time_ms,
+            r.time_min_ms,
+            r.time_max_ms,
             e.covered,
             e.id_diff,
             e.coverage_diff,
@@ -153,6 +234,10 @@ pub fn markdown(info: &RunInfo, summary: &[Summary], rows: &[Row]) -> String {
          largest clip-space component error relative to `w`; *vertex err*: largest window-space \
          error of a vertex in pixels (x, y) and in window depth (z), all against `f64`, before \
          snapping.\n\
+         - *M4F render*, *M0 render*: the firmware's instructions for the frame less the display \
+         push, on the Cortex-M4F (`mps2-an386`) and the Cortex-M0 (`microbit`), the four cubes at \
+         320x240 in this configuration; *rasterization*: the render less the strip clears and the \
+         geometry.\n\
          - *time*: the whole frame on one thread: matrices, setup of every triangle, clearing and \
          rendering all rows into `Rgb888` and the depth buffer.\n"
     );

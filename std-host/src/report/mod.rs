@@ -33,11 +33,30 @@
 //! interpolation and 1 LSB of rounding. Whatever is left is counted as
 //! "unexplained" and would be a bug in the core.
 //!
+//! The speed axis of record is not the host's time but the firmware's:
+//! the instructions the four-cubes frame takes on the Cortex-M4F and the
+//! Cortex-M0 under QEMU (`-icount shift=0`, deterministic) in the same
+//! configuration, from `docs/embedded.md`'s configuration table, which
+//! `.ci/firmware.sh` measures and holds every run to ([`firmware`]). The
+//! host time stays as a second axis, with its spread (the fastest and the
+//! slowest of the repetitions).
+//!
+//! Stars: a configuration is starred (on the Pareto front of speed
+//! against pixels differing) only where its lead is larger than the
+//! noise: it must be faster, by more than the noise, than every
+//! configuration at least as accurate ([`significant_front`]). For
+//! instruction counts the noise is taken as 1 % ([`firmware::COUNT_NOISE`],
+//! well over the SysTick granularity); for host time the ranges (min to
+//! max over the repetitions) must not overlap. The errors are
+//! deterministic, so any lead in accuracy is real.
+//!
 //! Output: `OUT_DIR/speed-vs-error.md` (tables) and
-//! `OUT_DIR/speed-vs-error.png` (time against error, one point per
-//! configuration, the Pareto front marked), drawn with `plotters`; text in
-//! the plot is drawn with embedded-graphics' built-in mono font, so no
-//! system font is needed.
+//! `OUT_DIR/speed-vs-error.png` (error against M4F render instructions,
+//! and against host time with its spread as error bars, one point per
+//! configuration, the starred front marked), drawn with `plotters`; text
+//! in the plot is drawn with embedded-graphics' built-in mono font, so no
+//! system font is needed, and point labels are placed so that they do not
+//! overlap.
 //!
 //! The code is split by concern: [`scenes`] (the scenes and their matrices),
 //! `core_run` (the timed core frames), [`reference`](mod@reference) (the `f64` renderer),
@@ -60,6 +79,7 @@ use std::time::Instant;
 
 mod compare;
 mod core_run;
+pub mod firmware;
 mod markdown;
 mod plot;
 pub mod reference;
@@ -158,6 +178,10 @@ pub struct Row {
     pub config: Configuration,
     /// Median frame time, milliseconds.
     pub time_ms: f64,
+    /// Fastest of the repetitions, milliseconds.
+    pub time_min_ms: f64,
+    /// Slowest of the repetitions, milliseconds.
+    pub time_max_ms: f64,
     /// Errors against the reference.
     pub errors: ErrorStats,
     /// Vertex-stage error.
@@ -171,6 +195,13 @@ pub struct Summary {
     pub config: Configuration,
     /// Sum of the scenes' median frame times, milliseconds.
     pub time_ms: f64,
+    /// Sum of the scenes' fastest frame times, milliseconds.
+    pub time_min_ms: f64,
+    /// Sum of the scenes' slowest frame times, milliseconds.
+    pub time_max_ms: f64,
+    /// The firmware's instruction counts in this configuration (the
+    /// cubes at 320x240, from `docs/embedded.md`).
+    pub device: firmware::DeviceCounts,
     /// Pixels whose triangle differs, percent of the reference's covered
     /// pixels (all scenes together).
     pub id_diff_pct: f64,
@@ -197,8 +228,8 @@ pub struct Summary {
 }
 
 /// Sums rows into one summary per configuration, in [`CONFIGURATIONS`]
-/// order.
-pub fn summarize(rows: &[Row]) -> Vec<Summary> {
+/// order, with the firmware's counts from `device` (see [`firmware`]).
+pub fn summarize(rows: &[Row], device: &[firmware::FirmwareRow]) -> Vec<Summary> {
     let mut out = Vec::new();
     for c in CONFIGURATIONS {
         let rs: Vec<&Row> = rows.iter().filter(|r| r.config == c).collect();
@@ -212,6 +243,9 @@ pub fn summarize(rows: &[Row]) -> Vec<Summary> {
         out.push(Summary {
             config: c,
             time_ms: rs.iter().map(|r| r.time_ms).sum(),
+            time_min_ms: rs.iter().map(|r| r.time_min_ms).sum(),
+            time_max_ms: rs.iter().map(|r| r.time_max_ms).sum(),
+            device: firmware::counts(device, &c),
             id_diff_pct: 100.0 * sum(&|r| r.errors.id_diff) as f64 / covered as f64,
             coverage_diff_pct: 100.0 * sum(&|r| r.errors.coverage_diff) as f64 / covered as f64,
             unexplained: sum(&|r| r.errors.unexplained),
@@ -230,6 +264,47 @@ pub fn summarize(rows: &[Row]) -> Vec<Summary> {
         });
     }
     out
+}
+
+/// The starred configurations: each point `i` is `(lo, hi, y)`, its speed
+/// as a range (lower is faster: the noise around a count, or the fastest
+/// and slowest of the repetitions) and its error `y` (lower is better,
+/// exact). `i` is starred where it is faster beyond the noise than every
+/// other point at least as accurate: `hi_i < lo_j` for every `j` with
+/// `y_j <= y_i`. That is a subset of the Pareto front of the midpoints:
+/// a configuration that only ties (within the noise) with one at least as
+/// accurate is not starred. Points with a NaN are never starred, and do
+/// not count against others. Sorted by speed.
+pub fn significant_front(points: &[(f64, f64, f64)]) -> Vec<usize> {
+    let ok = |&(lo, hi, y): &(f64, f64, f64)| !(lo.is_nan() || hi.is_nan() || y.is_nan());
+    let mut front: Vec<usize> = (0..points.len())
+        .filter(|&i| {
+            let (_, hi, y) = points[i];
+            ok(&points[i])
+                && points
+                    .iter()
+                    .enumerate()
+                    .all(|(j, p)| j == i || !ok(p) || p.2 > y || hi < p.0)
+        })
+        .collect();
+    front.sort_by(|&i, &j| points[i].0.total_cmp(&points[j].0));
+    front
+}
+
+/// A count's range under [`firmware::COUNT_NOISE`]: half the noise either
+/// side, so that two ranges are apart only where one count leads the other
+/// by more than the noise.
+pub fn count_range(n: Option<u64>) -> (f64, f64) {
+    match n {
+        Some(n) => {
+            let x = n as f64;
+            (
+                x * (1.0 - firmware::COUNT_NOISE / 2.0),
+                x * (1.0 + firmware::COUNT_NOISE / 2.0),
+            )
+        }
+        None => (f64::NAN, f64::NAN),
+    }
 }
 
 /// The settings a report ran with.
@@ -347,6 +422,8 @@ fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
                 scene: name.clone(),
                 config: *config,
                 time_ms: median(t),
+                time_min_ms: t.iter().copied().fold(f64::INFINITY, f64::min),
+                time_max_ms: t.iter().copied().fold(f64::NEG_INFINITY, f64::max),
                 errors,
                 vertex,
             });
@@ -360,9 +437,10 @@ fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
         height,
         reps,
     };
-    let summary = summarize(&rows);
+    let device = firmware::table()?;
+    let summary = summarize(&rows, &device);
     let md_path = args.out_dir.join("speed-vs-error.md");
-    std::fs::write(&md_path, markdown(&info, &summary, &rows))
+    std::fs::write(&md_path, markdown(&info, &summary, &rows, &device))
         .map_err(|e| format!("{}: cannot write: {e}", md_path.display()))?;
     let png_path = args.out_dir.join("speed-vs-error.png");
     plot::write_png(&png_path, &info, &summary)?;
@@ -396,6 +474,44 @@ mod tests {
         assert!(pareto_front(&[]).is_empty());
         // One point is its own front.
         assert_eq!(pareto_front(&[(3.0, 3.0)]), vec![0]);
+    }
+
+    #[test]
+    fn stars_need_a_lead_over_the_noise() {
+        // (lo, hi, y): speed range and error.
+        let pts = [
+            (0.5, 0.6, 5.0),  // 0: fastest by far, least accurate: starred
+            (1.1, 1.3, 3.0),  // 1: more accurate, slower than 0: starred
+            (2.0, 2.1, 3.0),  // 2: as accurate as 1 and slower: no star
+            (1.25, 1.4, 5.0), // 3: as accurate as 0 and slower: no star
+            (3.0, 3.1, 1.0),  // 4: the most accurate: starred
+            (2.5, 3.05, 1.0), // 5: as accurate as 4, ranges overlap: neither leads
+            (f64::NAN, f64::NAN, 0.0),
+        ];
+        // 1 is starred: everything at least as accurate (2, 4, 5) is
+        // slower beyond the noise. 4 and 5 tie: neither is starred.
+        assert_eq!(significant_front(&pts), vec![0, 1]);
+        // A lead within the noise over a more accurate point is no lead.
+        let tie = [(1.0, 1.2, 5.0), (1.1, 1.3, 3.0)];
+        assert_eq!(significant_front(&tie), vec![1]);
+        // Apart, the faster of two equally accurate points is starred.
+        let apart = [(1.0, 1.1, 2.0), (1.2, 1.3, 2.0)];
+        assert_eq!(significant_front(&apart), vec![0]);
+        // With no noise it is the Pareto front (less ties).
+        let exact: Vec<(f64, f64, f64)> = [(1.0, 5.0), (2.0, 3.0), (2.5, 3.0), (3.0, 1.0)]
+            .iter()
+            .map(|&(x, y)| (x, x, y))
+            .collect();
+        assert_eq!(significant_front(&exact), vec![0, 1, 3]);
+        // Counts: a 0.5 % lead is noise, a 2 % lead is not.
+        let (a, b, c) = (
+            count_range(Some(100_000)),
+            count_range(Some(100_500)),
+            count_range(Some(102_000)),
+        );
+        assert!(a.1 >= b.0 && b.1 >= a.0);
+        assert!(a.1 < c.0);
+        assert!(count_range(None).0.is_nan());
     }
 
     #[test]

@@ -1,11 +1,16 @@
-//! The report's plot: frame time against error, one point per
-//! configuration, the Pareto front marked.
+//! The report's plot: error against speed, one point per configuration,
+//! the starred front marked. Top row: against the M4F's render
+//! instructions (the firmware's, from `docs/embedded.md`); bottom row:
+//! against the host's frame time, the median with the fastest and slowest
+//! repetition as error bars.
 //!
 //! Design note: drawn with `plotters` into an RGB8 buffer; its text is drawn
 //! afterwards with embedded-graphics' built-in mono font, so no system font
-//! is needed, and the PNG is written with the host's own encoder.
+//! is needed, and the PNG is written with the host's own encoder. Point
+//! labels are placed with a collision check against the points, the error
+//! bars and the labels placed before them ([`place_point_labels`]).
 
-use super::{pareto_front, RunInfo, Summary};
+use super::{count_range, significant_front, RunInfo, Summary};
 use embedded_graphics::mono_font::{ascii, MonoFont, MonoTextStyle};
 use embedded_graphics::pixelcolor::Rgb888 as EgRgb;
 use embedded_graphics::prelude::{DrawTarget, OriginDimensions, Point, Size};
@@ -15,7 +20,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 const W: u32 = 1200;
-const H: u32 = 600;
+const H: u32 = 1100;
 
 /// A text label to draw after plotting, at backend pixel coordinates.
 struct Label {
@@ -89,7 +94,14 @@ fn fmt_tick(v: f64) -> String {
 struct Panel<'a> {
     title: &'a str,
     y_label: &'a str,
+    x_label: &'a str,
     log_y: bool,
+    /// Speed (lower is faster): the point's x.
+    xs: Vec<f64>,
+    /// Its range (the noise, or min and max): what starring compares.
+    ranges: Vec<(f64, f64)>,
+    /// Draw the ranges as error bars.
+    bars: bool,
     ys: Vec<f64>,
 }
 
@@ -103,15 +115,29 @@ fn err<E: std::fmt::Debug>(e: E) -> String {
 fn draw_panel(
     area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
     panel: &Panel<'_>,
-    xs: &[f64],
     names: &[String],
     labels: &mut Vec<Label>,
 ) -> PResult<()> {
+    let xs = &panel.xs;
     let (x_lo, x_hi) = xs
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        });
+        .zip(&panel.ranges)
+        .filter(|(x, _)| x.is_finite())
+        .fold(
+            (f64::INFINITY, f64::NEG_INFINITY),
+            |(a, b), (&x, &(lo, hi))| {
+                if panel.bars {
+                    (a.min(lo), b.max(hi))
+                } else {
+                    (a.min(x), b.max(x))
+                }
+            },
+        );
+    let (x_lo, x_hi) = if x_lo.is_finite() {
+        (x_lo, x_hi)
+    } else {
+        (0.0, 1.0)
+    };
     let pad = ((x_hi - x_lo) * 0.15).max(x_hi.abs() * 0.02).max(1e-3);
     let (x0, x1) = ((x_lo - pad).max(0.0), x_hi + pad);
     let ys = &panel.ys;
@@ -127,7 +153,14 @@ fn draw_panel(
         (1e-9, 1.0)
     };
     let points: Vec<(f64, f64)> = xs.iter().copied().zip(ys.iter().copied()).collect();
-    let front = pareto_front(&points);
+    let front = significant_front(
+        &panel
+            .ranges
+            .iter()
+            .zip(ys)
+            .map(|(&(lo, hi), &y)| (lo, hi, y))
+            .collect::<Vec<_>>(),
+    );
     let (margin_l, margin_b, margin_t, margin_r) = (80, 64, 50, 20);
     let (aw, ah) = area.dim_in_pixel();
     let (ox, oy) = area.get_base_pixel();
@@ -147,7 +180,7 @@ fn draw_panel(
         big: false,
     });
     labels.push(Label {
-        text: "frame time, sum over scenes (ms)".into(),
+        text: panel.x_label.into(),
         at: (ox + aw as i32 / 2, oy + ah as i32 - 22),
         align: Alignment::Center,
         baseline: Baseline::Bottom,
@@ -158,6 +191,13 @@ fn draw_panel(
     let front_color = RGBColor(213, 94, 0);
     let point_color = RGBColor(0, 114, 178);
     let mut point_px: Vec<((i32, i32), usize)> = Vec::new();
+    let mut bar_px: Vec<(i32, i32, i32, i32)> = Vec::new();
+    let plot_rect = (
+        ox + margin_l,
+        oy + margin_t,
+        aw as i32 - margin_l - margin_r,
+        ah as i32 - margin_t - margin_b,
+    );
     macro_rules! body {
         ($chart:expr, $y_ticks:expr, $fy:expr) => {{
             let chart = &mut $chart;
@@ -205,8 +245,24 @@ fn draw_panel(
                 .draw_series(LineSeries::new(fp, front_color.stroke_width(2)))
                 .map_err(err)?;
             for (i, &(x, y)) in points.iter().enumerate() {
-                if !y.is_finite() || (panel.log_y && y <= 0.0) {
+                if !x.is_finite() || !y.is_finite() || (panel.log_y && y <= 0.0) {
                     continue;
+                }
+                if panel.bars {
+                    let (lo, hi) = panel.ranges[i];
+                    let (l, by) = chart.backend_coord(&(lo, y));
+                    let (r, _) = chart.backend_coord(&(hi, y));
+                    bar_px.push((l, by - 5, r, by + 5));
+                    chart
+                        .draw_series(LineSeries::new([(lo, y), (hi, y)], axis))
+                        .map_err(err)?;
+                    for e in [l, r] {
+                        area.draw(&PathElement::new(
+                            [(e - ox, by - oy - 4), (e - ox, by - oy + 4)],
+                            axis,
+                        ))
+                        .map_err(err)?;
+                    }
                 }
                 let on = front.contains(&i);
                 let style = if on {
@@ -241,42 +297,77 @@ fn draw_panel(
             .map_err(err)?;
         body!(chart, nice_ticks(0.0, hi, 6), (0.0, hi));
     }
-    place_point_labels(&point_px, names, (ox, oy, aw as i32, ah as i32), labels);
+    let placed = place_point_labels(&point_px, &bar_px, names, plot_rect);
+    // A label moved away from its point gets a thin leader line to it.
+    for (l, &((px, py), _)) in placed.iter().zip(&point_px) {
+        let r = label_rect(l);
+        let (cx, cy) = (px.clamp(r.0, r.2), py.clamp(r.1, r.3));
+        if (cx - px).abs() + (cy - py).abs() > 16 {
+            area.draw(&PathElement::new(
+                [(px - ox, py - oy), (cx - ox, cy - oy)],
+                RGBColor(150, 150, 150),
+            ))
+            .map_err(err)?;
+        }
+    }
+    labels.extend(placed);
     Ok(())
 }
 
-/// Places each point's name next to it where it overlaps no other
-/// name and no point, trying a few positions around the point.
+/// A label's box: left, top, right, bottom.
+type Rect = (i32, i32, i32, i32);
+
+/// The box of a point label (6x10 font, left-top anchored).
+fn label_rect(l: &Label) -> Rect {
+    let w = l.text.len() as i32 * 6;
+    (l.at.0, l.at.1, l.at.0 + w, l.at.1 + 10)
+}
+
+fn overlaps(a: &Rect, b: &Rect) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// Each point's name next to it, overlapping no other name, no point and
+/// no error bar (`obstacles`), inside `area` (left, top, width, height):
+/// a few positions around the point first, then the first free one
+/// straight above or below it (offset a line at a time), then further
+/// out to the sides.
 fn place_point_labels(
     points: &[((i32, i32), usize)],
+    obstacles: &[Rect],
     names: &[String],
     area: (i32, i32, i32, i32),
-    labels: &mut Vec<Label>,
-) {
-    type Rect = (i32, i32, i32, i32);
-    let overlaps = |a: &Rect, b: &Rect| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
+) -> Vec<Label> {
+    let mut labels = Vec::new();
     let mut taken: Vec<Rect> = points
         .iter()
         .map(|&((x, y), _)| (x - 6, y - 6, x + 6, y + 6))
+        .chain(obstacles.iter().copied())
         .collect();
     for &((x, y), i) in points {
         let (w, h) = (names[i].len() as i32 * 6, 10);
-        let candidates = [
-            (8, -5),
-            (8, -16),
-            (8, 6),
-            (-8 - w, -5),
-            (-8 - w, -16),
-            (-8 - w, 6),
+        let mut candidates = vec![
+            (11, -5),
+            (11, -16),
+            (11, 6),
+            (-11 - w, -5),
+            (-11 - w, -16),
+            (-11 - w, 6),
             (-w / 2, -20),
             (-w / 2, 9),
-            (8, -28),
-            (8, 18),
-            (-8 - w, -28),
-            (-8 - w, 18),
-            (8, -40),
-            (8, 30),
+            (11, -28),
+            (11, 18),
+            (-11 - w, -28),
+            (-11 - w, 18),
+            (11, -40),
+            (11, 30),
         ];
+        for dx in [11, -11 - w, -w / 2, 24, -24 - w] {
+            for k in 1..60 {
+                candidates.push((dx, -5 - 11 * k));
+                candidates.push((dx, -5 + 11 * k));
+            }
+        }
         let inside = |r: &Rect| {
             r.0 >= area.0 && r.1 >= area.1 && r.2 <= area.0 + area.2 && r.3 <= area.1 + area.3
         };
@@ -284,7 +375,12 @@ fn place_point_labels(
         let pick = candidates
             .iter()
             .map(|&c| rect_at(c))
-            .find(|r| inside(r) && !taken.iter().any(|t| overlaps(r, t)))
+            .find(|r| {
+                // A gap of a few pixels between labels, so that two never
+                // read as one.
+                let padded = (r.0 - 4, r.1 - 1, r.2 + 4, r.3 + 1);
+                inside(r) && !taken.iter().any(|t| overlaps(&padded, t))
+            })
             .unwrap_or_else(|| rect_at(candidates[0]));
         taken.push(pick);
         labels.push(Label {
@@ -295,47 +391,80 @@ fn place_point_labels(
             big: false,
         });
     }
+    labels
 }
 
 /// Draws the two panels and writes the PNG.
 pub fn write_png(path: &Path, info: &RunInfo, summary: &[Summary]) -> Result<(), String> {
     let mut buf = vec![255u8; (W * H * 3) as usize];
     let mut labels = Vec::new();
-    let xs: Vec<f64> = summary.iter().map(|s| s.time_ms).collect();
     let names: Vec<String> = summary.iter().map(|s| s.config.label()).collect();
+    // The M4F's counts in thousands; their ranges are the count noise.
+    let kilo = |n: Option<u64>| n.map_or(f64::NAN, |n| n as f64 / 1e3);
+    let count_xs: Vec<f64> = summary.iter().map(|s| kilo(s.device.m4f_render)).collect();
+    let count_ranges: Vec<(f64, f64)> = summary
+        .iter()
+        .map(|s| {
+            let (lo, hi) = count_range(s.device.m4f_render);
+            (lo / 1e3, hi / 1e3)
+        })
+        .collect();
+    let time_xs: Vec<f64> = summary.iter().map(|s| s.time_ms).collect();
+    let time_ranges: Vec<(f64, f64)> = summary
+        .iter()
+        .map(|s| (s.time_min_ms, s.time_max_ms))
+        .collect();
+    let coverage: Vec<f64> = summary.iter().map(|s| s.id_diff_pct).collect();
+    let depth: Vec<f64> = summary.iter().map(|s| s.depth_mean_abs).collect();
+    let count_label = "M4F render, thousands of instructions (firmware: cubes, 320x240, QEMU)";
+    let time_label = "host frame time, sum over scenes (ms): median, bars min-max";
     {
         let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let (left, right) = root.split_horizontally(W / 2);
-        draw_panel(
-            &left,
-            &Panel {
-                title: "Coverage: pixels whose triangle differs from f64",
-                y_label: "% of covered pixels (log scale)",
-                log_y: true,
-                ys: summary.iter().map(|s| s.id_diff_pct).collect(),
-            },
-            &xs,
-            &names,
-            &mut labels,
-        )?;
-        draw_panel(
-            &right,
-            &Panel {
-                title: "Depth: mean stored-vs-exact error",
-                y_label: "window depth, [0, 1] (log scale)",
-                log_y: true,
-                ys: summary.iter().map(|s| s.depth_mean_abs).collect(),
-            },
-            &xs,
-            &names,
-            &mut labels,
-        )?;
+        let (top, bottom) = root.split_vertically((H - 20) / 2);
+        let bottom = bottom.margin(0, 20, 0, 0);
+        for (row, xs, ranges, x_label, bars) in [
+            (&top, &count_xs, &count_ranges, count_label, false),
+            (&bottom, &time_xs, &time_ranges, time_label, true),
+        ] {
+            let (left, right) = row.split_horizontally(W / 2);
+            draw_panel(
+                &left,
+                &Panel {
+                    title: "Coverage: pixels whose triangle differs from f64",
+                    y_label: "% of covered pixels (log scale)",
+                    x_label,
+                    log_y: true,
+                    xs: xs.clone(),
+                    ranges: ranges.clone(),
+                    bars,
+                    ys: coverage.clone(),
+                },
+                &names,
+                &mut labels,
+            )?;
+            draw_panel(
+                &right,
+                &Panel {
+                    title: "Depth: mean stored-vs-exact error",
+                    y_label: "window depth, [0, 1] (log scale)",
+                    x_label,
+                    log_y: true,
+                    xs: xs.clone(),
+                    ranges: ranges.clone(),
+                    bars,
+                    ys: depth.clone(),
+                },
+                &names,
+                &mut labels,
+            )?;
+        }
         root.present().map_err(err)?;
     }
     labels.push(Label {
         text: format!(
-            "{}x{}, one thread, median of {} frames; filled points and line: Pareto front",
+            "host: {}x{}, one thread, {} frames; filled points and line: the front where the lead \
+             beats the noise (counts: 1 %; time: the min-max ranges do not overlap)",
             info.width, info.height, info.reps
         ),
         at: (W as i32 / 2, H as i32 - 4),
@@ -359,4 +488,42 @@ pub fn write_png(path: &Path, info: &RunInfo, summary: &[Summary]) -> Result<(),
             Text::with_text_style(&l.text, Point::new(l.at.0, l.at.1), style, ts).draw(&mut canvas);
     }
     crate::image_out::write_rgb(path, W, H, &buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_labels_do_not_overlap_each_other_points_or_bars() {
+        // Eight points in a tight cluster and two on top of each other,
+        // with an error bar through the cluster.
+        let mut points: Vec<((i32, i32), usize)> = (0..8)
+            .map(|i| ((300 + (i % 3) * 4, 300 + (i / 3) * 5), i as usize))
+            .collect();
+        points.push(((500, 200), 8));
+        points.push(((500, 200), 9));
+        let names: Vec<String> = (0..10).map(|i| format!("S{i} u16 micromath")).collect();
+        let bars = [(250, 305, 400, 315)];
+        let area = (100, 100, 600, 400);
+        let labels = place_point_labels(&points, &bars, &names, area);
+        assert_eq!(labels.len(), points.len());
+        let rects: Vec<Rect> = labels.iter().map(label_rect).collect();
+        for (i, a) in rects.iter().enumerate() {
+            assert!(
+                a.0 >= area.0 && a.1 >= area.1 && a.2 <= area.0 + area.2 && a.3 <= area.1 + area.3,
+                "{a:?} outside"
+            );
+            for b in &rects[..i] {
+                assert!(!overlaps(a, b), "{a:?} overlaps {b:?}");
+            }
+            for &((x, y), _) in &points {
+                assert!(
+                    !overlaps(a, &(x - 6, y - 6, x + 6, y + 6)),
+                    "{a:?} on a point"
+                );
+            }
+            assert!(!overlaps(a, &bars[0]), "{a:?} on the bar");
+        }
+    }
 }
