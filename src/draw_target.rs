@@ -485,7 +485,11 @@ mod tests {
             drawer.draw_frame(&mut display, &frame).unwrap();
             display.assert_eq_with_message(&expected, |f| write!(f, "frame, {rows} rows"));
 
-            // The shaded entry points with the default shader: the same.
+            // The shaded entry points with the default shader: the same
+            // (two heights: the loop runs under Miri too).
+            if rows != 7 && rows != 40 {
+                continue;
+            }
             let mut display = MockDisplay::<P>::new();
             drawer
                 .draw_shaded::<_, _, _, 8, 3>(&mut display, config(), crate::VertexColor, |strip| {
