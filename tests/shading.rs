@@ -337,7 +337,7 @@ proptest! {
 
     /// Texture coordinates are within 1/256 texel of the `f64`
     /// perspective-correct value for a 1024x1024 texture (`|u|, |v| <= 2`,
-    /// `w` ratios up to 60).
+    /// `w` ratios up to 67 (`w` in 0.3..20)).
     #[test]
     fn texture_coordinates_are_within_1_256_texel(
         p in triangle(false),
