@@ -228,14 +228,16 @@ impl Material {
 /// component first, so no finite non-zero vector under- or overflows.
 #[inline]
 fn normalize(v: Vec3) -> Option<Vec3> {
-    // (`f32::max` below would drop a NaN component.)
-    if !v.is_finite() {
-        return None;
-    }
     let n2 = v.dot(v);
+    // Only finite vectors pass (a NaN or infinite component makes `n2`
+    // NaN or infinite).
     if n2 > 1e-30 && n2 < 1e30 {
         let inv = 1.0 / fx::sqrt(n2);
         return Some(Vec3::new(v.x * inv, v.y * inv, v.z * inv));
+    }
+    // (`f32::max` below would drop a NaN component.)
+    if !v.is_finite() {
+        return None;
     }
     let m = v.x.abs().max(v.y.abs()).max(v.z.abs());
     if !(m > 0.0 && m.is_finite()) {
