@@ -116,6 +116,47 @@ fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
     written
 }
 
+/// Whether `z0 + n * dz` lies in `[0, 2^48)` (the `Z32.16` range, where
+/// [`z32_of`] clamps nothing) for every `n < len`, so the stepped values are
+/// the exact ones: both ends are in range and the steps are small enough
+/// that no sum wraps (`|dz| < 2^40`, `len <= 2^16`: `|n dz| < 2^56`); a
+/// linear function in range at both ends is in range between them.
+#[inline]
+fn in_range_throughout(z0: i64, dz: i64, len: usize) -> bool {
+    const TOP: i64 = 1 << 48;
+    if len == 0 || len > 1 << 16 || dz.unsigned_abs() >= 1 << 40 {
+        return false;
+    }
+    let last = z0 + dz * (len as i64 - 1);
+    (0..TOP).contains(&z0) && (0..TOP).contains(&last)
+}
+
+/// The flat-span loop of [`DepthBuffer::flat_span`] for `Less` (`LE =
+/// false`) or `LessEqual` with writes, where [`in_range_throughout`] holds:
+/// `z` is never clamped, so the word is [`DepthWord::from_z32_16_in_range`]
+/// of the wrapping `u64` sum (an add with carry on a 32-bit core).
+#[inline(always)]
+fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
+    c: &mut [C],
+    d: &mut [W],
+    z0: u64,
+    dz: u64,
+    px: C,
+) -> u32 {
+    let mut written = 0u32;
+    let mut z = z0;
+    for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+        let zw = W::from_z32_16_in_range(z);
+        if zw < *dp || (LE && zw == *dp) {
+            *dp = zw;
+            *cp = px;
+            written += 1;
+        }
+        z = z.wrapping_add(dz);
+    }
+    written
+}
+
 /// `Z32` of a `Z32.16` value (clamped). Spans step `z` by `dz` with
 /// wrapping additions: the same integers as `z0 + n * dz`, without the
 /// 64-bit multiply.
@@ -148,6 +189,12 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn from_z32_16(z: i64) -> Self {
         Self::from_z32(z32_of(z))
     }
+    /// [`from_z32_16`](DepthWord::from_z32_16) of a value already in
+    /// `[0, 2^48)`, which needs no clamp: a shift.
+    #[inline(always)]
+    fn from_z32_16_in_range(z: u64) -> Self {
+        Self::from_z32((z >> 16) as u32)
+    }
 }
 
 impl DepthWord for u16 {
@@ -167,6 +214,11 @@ impl DepthWord for u16 {
     #[inline(always)]
     fn from_z32_16(z: i64) -> Self {
         ((z >> 32).clamp(0, 0xffff)) as u16
+    }
+    /// The high word.
+    #[inline(always)]
+    fn from_z32_16_in_range(z: u64) -> Self {
+        (z >> 32) as u16
     }
 }
 
@@ -191,6 +243,7 @@ impl<W: DepthWord> DepthBuffer for [W] {
     const ENABLED: bool = true;
     const WIDE: bool = W::WIDE;
 
+    #[inline(always)]
     fn flat_span<C: Copy>(
         &mut self,
         color: &mut [C],
@@ -222,9 +275,17 @@ impl<W: DepthWord> DepthBuffer for [W] {
                 written += pass as u32;
                 z = z.wrapping_add(dz);
             }
-        } else {
+        } else if in_range_throughout(z0, dz, len) {
             // Microcontrollers have no vectors to fill: store only where
-            // the test passes (the same results, fewer instructions).
+            // the test passes (the same results, fewer instructions). The
+            // span's depth never leaves [0, 2^48), so no clamp: the word is
+            // a shift of `z`, stepped as two 32-bit words with a carry.
+            return if le {
+                span_unclamped::<W, C, true>(c, d, z0 as u64, dz as u64, px)
+            } else {
+                span_unclamped::<W, C, false>(c, d, z0 as u64, dz as u64, px)
+            };
+        } else {
             for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
                 let zw = W::from_z32_16(z);
                 if zw < *dp || (le && zw == *dp) {
@@ -329,6 +390,77 @@ impl DepthBuffer for NoDepth {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate std;
+    use proptest::prelude::*;
+
+    /// The microcontrollers' unclamped span loop (`span_unclamped`, which
+    /// the 64-bit host never runs inside `flat_span`) writes what the
+    /// pixel-by-pixel loop writes wherever `in_range_throughout` admits a
+    /// span, and that test admits only spans whose every value is in
+    /// `[0, 2^48)`.
+    fn unclamped_matches<W: DepthWord>(z0: i64, dz: i64, len: usize, seed: u64, le: bool) {
+        let stored: std::vec::Vec<W> = (0..len as u64)
+            .map(|n| {
+                let h = (seed ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                W::from_z32((h >> 32) as u32)
+            })
+            .collect();
+        let func = if le {
+            DepthFunc::LessEqual
+        } else {
+            DepthFunc::Less
+        };
+        let (mut d_ref, mut c_ref) = (stored.clone(), std::vec![0u8; len]);
+        let want = flat_span_each(&mut d_ref[..], &mut c_ref, 0, len, z0, dz, func, true, 1u8);
+        if !in_range_throughout(z0, dz, len) {
+            return;
+        }
+        for n in 0..len as i64 {
+            assert!((0..1i64 << 48).contains(&(z0 + n * dz)), "n {n}");
+        }
+        let (mut d, mut c) = (stored, std::vec![0u8; len]);
+        let got = if le {
+            span_unclamped::<W, u8, true>(&mut c, &mut d, z0 as u64, dz as u64, 1)
+        } else {
+            span_unclamped::<W, u8, false>(&mut c, &mut d, z0 as u64, dz as u64, 1)
+        };
+        assert_eq!((got, &d, &c), (want, &d_ref, &c_ref));
+    }
+
+    proptest! {
+        // Few cases under Miri (CI runs these unit tests there too), and no
+        // failure file, which Miri's isolation would refuse.
+        #![proptest_config(ProptestConfig {
+            cases: if cfg!(miri) { 4 } else { 256 },
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        })]
+        #[test]
+        fn unclamped_span_equals_clamped(
+            z0 in prop_oneof![0i64..1 << 48, -(1i64 << 20)..1 << 20, (1i64 << 48) - (1 << 20)..(1i64 << 48) + (1 << 20), any::<i64>()],
+            dz in prop_oneof![-(1i64 << 34)..1 << 34, -(1i64 << 42)..1 << 42, -4i64..4, any::<i64>()],
+            len in 1usize..300,
+            seed in any::<u64>(),
+            le in any::<bool>(),
+        ) {
+            unclamped_matches::<u16>(z0, dz, len, seed, le);
+            unclamped_matches::<u32>(z0, dz, len, seed, le);
+        }
+    }
+
+    #[test]
+    fn in_range_edges() {
+        let top = 1i64 << 48;
+        assert!(in_range_throughout(0, 0, 1));
+        assert!(in_range_throughout(top - 1, 0, 1));
+        assert!(!in_range_throughout(top, 0, 1));
+        assert!(!in_range_throughout(-1, 0, 1));
+        assert!(in_range_throughout(top - 10, -1, 1 << 16));
+        assert!(!in_range_throughout(5, -1, 7));
+        assert!(!in_range_throughout(0, 1, (1 << 16) + 1));
+        assert!(!in_range_throughout(0, 1 << 40, 2));
+        assert!(!in_range_throughout(0, 0, 0));
+    }
 
     #[test]
     fn funcs() {

@@ -99,6 +99,48 @@ fn round_to_coord(v: f32) -> Option<i32> {
     Some(i + up - down)
 }
 
+/// `x as i64` (truncation toward zero, saturating, NaN gives 0) without the
+/// library call a 32-bit core makes for it (`__aeabi_f2lz`, about 60
+/// instructions with Rust's saturation around it on a Cortex-M4F): below
+/// `2^31` the hardware `f32 -> i32` conversion, above it the integer
+/// significand shifted into place (an `f32` that large is an integer). The
+/// rasterizer converts each span's start depth (`Z32.16`, up to `2^48`)
+/// this way. Equal to `as` for every `f32` (tests: every exponent, the
+/// boundaries, random bit patterns; the exhaustive run is ignored by
+/// default).
+#[inline(always)]
+pub(crate) fn f32_as_i64(x: f32) -> i64 {
+    if cfg!(target_pointer_width = "64") {
+        // One instruction on a 64-bit host.
+        x as i64
+    } else {
+        f32_as_i64_by_parts(x)
+    }
+}
+
+/// [`f32_as_i64`] on 32-bit cores, tested on every host.
+#[inline(always)]
+pub(crate) fn f32_as_i64_by_parts(x: f32) -> i64 {
+    let bits = x.to_bits();
+    let exp = (bits >> 23) & 0xff;
+    // |x| < 2^31 (biased exponent below 127 + 31): exact in i32.
+    if exp < 158 {
+        return x as i32 as i64;
+    }
+    // |x| >= 2^63, infinities and NaN: what `as` saturates to.
+    if exp >= 190 {
+        return x as i64;
+    }
+    // 2^31 <= |x| < 2^63: the 24-bit significand times 2^(exp - 150),
+    // a left shift by 8..=39.
+    let mag = (((bits & 0x7f_ffff) | 0x80_0000) as i64) << (exp - 150);
+    if bits >> 31 != 0 {
+        -mag
+    } else {
+        mag
+    }
+}
+
 /// Fails to compile unless `S` is a supported subpixel precision (4 or 8):
 /// `const { check_subpixel_bits::<S>() }` in every function generic over
 /// `S` turns a bad `S` into a build error, never a run-time shift overflow.
@@ -228,6 +270,45 @@ pub const fn pixel_center<const S: u32>(i: i32) -> i64 {
 
 #[cfg(test)]
 mod tests {
+    /// `f32_as_i64_by_parts` against `as` at every exponent: both ends of each
+    /// binade, its middle, its neighbours, both signs, plus NaNs and
+    /// infinities.
+    #[test]
+    fn f32_as_i64_equals_as_at_every_exponent() {
+        let mut checked = 0;
+        for sign in [0u32, 1] {
+            for exp in 0u32..=255 {
+                for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
+                    let x = f32::from_bits(sign << 31 | exp << 23 | mant);
+                    assert_eq!(super::f32_as_i64_by_parts(x), x as i64, "{x:e} ({:#x})", x.to_bits());
+                    checked += 1;
+                }
+            }
+        }
+        for x in [
+            2147483648.0f32,
+            -2147483648.0,
+            2147483520.0,
+            -2147483520.0,
+            9.223372e18,
+            -9.223372e18,
+        ] {
+            assert_eq!(super::f32_as_i64_by_parts(x), x as i64, "{x:e}");
+        }
+        assert_eq!(checked, 2 * 256 * 7);
+    }
+
+    /// Every `f32` bit pattern (4 billion; about a minute in release):
+    /// `cargo test --release -p microraster --lib f32_as_i64_exhaustive -- --ignored`.
+    #[test]
+    #[ignore]
+    fn f32_as_i64_exhaustive() {
+        for bits in 0..=u32::MAX {
+            let x = f32::from_bits(bits);
+            assert_eq!(super::f32_as_i64_by_parts(x), x as i64, "{bits:#x}");
+        }
+    }
+
     use super::*;
 
     #[test]

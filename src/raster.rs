@@ -264,7 +264,7 @@ trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self>
 }
 
 macro_rules! impl_real {
-    ($t:ty) => {
+    ($t:ty, $to_i64:path) => {
         impl Real for $t {
             const ZERO: $t = 0.0;
             #[inline(always)]
@@ -290,14 +290,20 @@ macro_rules! impl_real {
             #[inline(always)]
             fn to_fixed16(self) -> i64 {
                 let q = self * 65536.0;
-                (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i64
+                $to_i64(q + if q >= 0.0 { 0.5 } else { -0.5 })
             }
         }
     };
 }
 
-impl_real!(f64);
-impl_real!(f32);
+impl_real!(f64, f64_as_i64);
+impl_real!(f32, crate::fixed::f32_as_i64);
+
+/// `x as i64`, as the macro's conversion for `f64`.
+#[inline(always)]
+fn f64_as_i64(x: f64) -> i64 {
+    x as i64
+}
 
 /// Per-triangle constants for shading a covered pixel.
 struct Shader<R, const N: usize> {

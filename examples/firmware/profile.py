@@ -12,7 +12,8 @@ instruction to the innermost function it was inlined from
 one symbol. Prints the top functions and source lines. The total covers
 the whole run (calibration loop, the frame, the measurement passes); the
 `spin` loop is the clock calibration. Needs qemu-system-arm and
-binutils-arm-none-eabi.
+binutils-arm-none-eabi. `--annotate FILE` writes the disassembly with
+each instruction's execution count, to read the hot loops.
 """
 import argparse
 import collections
@@ -51,6 +52,8 @@ def main():
     ap.add_argument("--target", default="thumbv7em-none-eabihf", choices=BOARDS)
     ap.add_argument("--features", default="")
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--annotate", metavar="FILE",
+                    help="also write the disassembly (objdump -d) with each instruction's count")
     a = ap.parse_args()
     here = os.path.dirname(os.path.abspath(__file__))
     subprocess.run(["cargo", "build", "-q", "--release", "--target", a.target,
@@ -115,6 +118,15 @@ def main():
             chain[addr] = pairs or [("?", "?")]
         else:
             i += 1
+
+    if a.annotate:
+        dis = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf],
+                             capture_output=True, text=True, check=True).stdout
+        with open(a.annotate, "w") as out:
+            for line in dis.splitlines():
+                m = re.match(r"^\s*([0-9a-f]+):", line)
+                n = count.get(int(m.group(1), 16), 0) if m else 0
+                out.write(f"{n:>9} {line}\n" if n else f"{'':>9} {line}\n")
 
     total = sum(count.values())
     funcs = collections.Counter()
