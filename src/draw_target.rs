@@ -8,6 +8,9 @@
 //! draws the rows into them, and pushes them to the target with **one**
 //! [`DrawTarget::fill_contiguous`] over the strip's rectangle (a display
 //! driver turns that into one address window and one burst of pixel data).
+//! A display whose driver hands the buffer to a DMA engine implements
+//! [`StripSink`] instead and gets each strip as the slice itself (every
+//! `DrawTarget` is a `StripSink` through a blanket implementation).
 //! The target's error is handed back unchanged in [`DrawError::Target`];
 //! the renderer's own errors (a buffer too small for one row, a bad frame
 //! size) in [`DrawError::Render`], before anything is drawn.
@@ -75,6 +78,80 @@ impl<E: core::error::Error + 'static> core::error::Error for DrawError<E> {
     }
 }
 
+/// Where a [`StripDrawer`] sends each finished strip: any [`DrawTarget`]
+/// whose colour converts from the strip's pixels (one `fill_contiguous`
+/// per strip, converting each pixel with `From`), or a display of your own
+/// that takes the strip buffer as it is.
+///
+/// Implement it for a driver that hands the buffer to a DMA engine: it
+/// gets the strip as a slice, with no per-pixel iterator in between (the
+/// Cortex-M firmware's display stand-in checksums the slice two pixels a
+/// word, at a third of what the same checksum costs behind
+/// `fill_contiguous`). A type that implements `DrawTarget` gets this trait
+/// from the blanket implementation, so implement it only for types that
+/// are not draw targets.
+///
+/// ```
+/// use embedded_graphics_core::primitives::Rectangle;
+/// use microraster::pixelcolor::{IntoStorage, Rgb565, Rgb888, RgbColor};
+/// use microraster::{Config, CullMode, StripDrawer, StripSink, Submit, Vec4};
+///
+/// /// Sums the strips' raw words, as a DMA engine with a CRC unit would.
+/// struct DmaDisplay {
+///     sum: u32,
+///     next_row: u32,
+/// }
+///
+/// impl StripSink<Rgb565> for DmaDisplay {
+///     type Error = &'static str;
+///     fn push_strip(&mut self, area: &Rectangle, pixels: &[Rgb565]) -> Result<(), Self::Error> {
+///         if area.top_left.y != self.next_row as i32 {
+///             return Err("out of order");
+///         }
+///         for p in pixels {
+///             self.sum = self.sum.wrapping_add(p.into_storage() as u32);
+///         }
+///         self.next_row += area.size.height;
+///         Ok(())
+///     }
+/// }
+///
+/// let mut color = [Rgb565::BLACK; 24 * 4];
+/// let mut depth = [0u16; 24 * 4];
+/// let mut display = DmaDisplay { sum: 0, next_row: 0 };
+/// let mut config = Config::new(24, 16);
+/// config.cull = CullMode::None;
+/// StripDrawer::new(&mut color, &mut depth, Rgb565::BLACK)
+///     .draw(&mut display, config, |strip| {
+///         let v = |x, y| Vec4::new(x, y, 0.5, 1.0);
+///         let tri = [v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)];
+///         strip.submit_clip_triangle(tri, [Rgb888::RED; 3], 0).unwrap();
+///     })
+///     .unwrap();
+/// // Four strips arrived in order; half of the 384 pixels are red.
+/// assert_eq!(display.next_row, 16);
+/// assert_eq!(display.sum, 192 * Rgb565::RED.into_storage() as u32);
+/// ```
+pub trait StripSink<P> {
+    /// What a failed push returns ([`DrawError::Target`]).
+    type Error;
+    /// Takes the strip `area` of the frame (the frame's rows `y0..y1` at
+    /// the drawer's origin: `area.size.width` pixels a row), whose
+    /// pixels are `pixels`, row by row, top to bottom.
+    fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), Self::Error>;
+}
+
+impl<P: Copy, T: DrawTarget> StripSink<P> for T
+where
+    T::Color: From<P>,
+{
+    type Error = T::Error;
+    /// One `fill_contiguous` over the strip's rectangle.
+    fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), T::Error> {
+        self.fill_contiguous(area, pixels.iter().map(|&p| T::Color::from(p)))
+    }
+}
+
 /// The depth strip of a [`StripDrawer`]: `&mut [u16]`, `&mut [u32]`
 /// (or arrays of them), or [`NoDepth`] by value.
 pub trait StripDepth {
@@ -123,7 +200,8 @@ impl StripDepth for NoDepth {
     }
 }
 
-/// Draws frames into a [`DrawTarget`] through a strip buffer of `P` pixels
+/// Draws frames into a [`DrawTarget`] (or any [`StripSink`]) through a
+/// strip buffer of `P` pixels
 /// and a depth strip `D` (`&mut [u16]`, `&mut [u32]` or [`NoDepth`]).
 ///
 /// The strip holds `color.len() / width` rows of a frame `width` pixels
@@ -227,8 +305,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         scene: F,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
         F: FnMut(&mut StripRenderer<'_, P, D::Rows, SUBPIXEL_BITS>),
     {
         self.draw_subpixel::<T, F, SUBPIXEL_BITS>(target, config, scene)
@@ -242,8 +319,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         mut scene: F,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
         F: FnMut(&mut StripRenderer<'_, P, D::Rows, S>),
     {
         self.for_each_strip(target, config, |y0, y1, color, depth| {
@@ -266,8 +342,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         mut scene: F,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
         Sh: crate::shade::FragmentShader<N> + Copy,
         F: FnMut(&mut StripRenderer<'_, P, D::Rows, S, N, Sh>),
     {
@@ -288,8 +363,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         frame: &Frame<'_, S>,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
     {
         self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
             frame.render_rows(y0, y1, color, depth)
@@ -305,8 +379,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         fragment: &F,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
         F: crate::shade::FragmentShader<N>,
     {
         self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
@@ -323,8 +396,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         mut render: R,
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
-        T: DrawTarget,
-        T::Color: From<P>,
+        T: StripSink<P>,
         R: FnMut(u32, u32, &mut [P], &mut D::Rows) -> Result<RenderStats, Error>,
     {
         crate::config::check_size(&config)?;
@@ -369,9 +441,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             // y0 < 2^14; saturating keeps an absurd origin from overflowing.
             let top = Point::new(self.origin.x, self.origin.y.saturating_add(y0 as i32));
             let area = Rectangle::new(top, Size::new(width, y1 - y0));
-            target
-                .fill_contiguous(&area, color.iter().map(|&p| T::Color::from(p)))
-                .map_err(DrawError::Target)?;
+            target.push_strip(&area, color).map_err(DrawError::Target)?;
             y0 = y1;
         }
         Ok(total)

@@ -280,7 +280,12 @@ mod tests {
             for exp in 0u32..=255 {
                 for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
                     let x = f32::from_bits(sign << 31 | exp << 23 | mant);
-                    assert_eq!(super::f32_as_i64_by_parts(x), x as i64, "{x:e} ({:#x})", x.to_bits());
+                    assert_eq!(
+                        super::f32_as_i64_by_parts(x),
+                        x as i64,
+                        "{x:e} ({:#x})",
+                        x.to_bits()
+                    );
                     checked += 1;
                 }
             }

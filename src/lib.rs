@@ -97,7 +97,7 @@ pub use clip::ClipVertex;
 pub use color::{PixelFormat, TriangleId};
 pub use config::{Config, CullMode, Error, FrontFace};
 pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
-pub use draw_target::{DrawError, StripDepth, StripDrawer};
+pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
 pub use frame::Frame;
 pub use math::{Mat4, Vec3, Vec4};

@@ -1,29 +1,29 @@
-//! The display stand-in: a [`DrawTarget`] that checksums what it receives.
+//! The display stand-in: a [`StripSink`] that checksums what it receives.
 //!
-//! It behaves like a driver for an SPI display that is only ever written
-//! whole rows at a time: each `fill_contiguous` must cover full rows and
-//! continue where the last one stopped (anything else is an error, which
-//! the strip adapter hands back), and its pixels go, two to a 32-bit word
-//! as a DMA transfer packs them, into a checksum
+//! It behaves like a DMA-driven driver for an SPI display that is only
+//! ever written whole rows at a time: it takes each finished strip buffer
+//! as a slice (no per-pixel iterator, as a DMA engine reads the buffer),
+//! each strip must cover full rows and continue where the last one stopped
+//! (anything else is an error, which the strip drawer hands back), and its
+//! pixels go, two to a 32-bit word as a DMA transfer packs them, into a
+//! checksum
 //! (`microraster_scenes::checksum`: two additions a word) instead of onto
 //! the wire. The checksum of a frame does not depend on how it was cut
 //! into strips (rows are an even number of pixels wide). The instructions
 //! it spends are counted apart, on their own line.
 
 use crate::clock::Clock;
-use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
+use microraster::StripSink;
 use microraster_scenes::checksum::FrameChecksum;
 
 /// Why the stand-in refused a write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DisplayError {
-    /// A single-pixel write (`draw_iter`): this display takes rectangles.
-    NotContiguous,
-    /// A rectangle that is not the next full rows of the frame.
+    /// A rectangle that is not the next full rows of the frame, or pixels
+    /// that do not fill it.
     OutOfOrder,
 }
 
@@ -64,45 +64,32 @@ impl OriginDimensions for HashDisplay {
     }
 }
 
-impl DrawTarget for HashDisplay {
-    type Color = Rgb565;
+impl StripSink<Rgb565> for HashDisplay {
     type Error = DisplayError;
 
-    fn draw_iter<I>(&mut self, _: I) -> Result<(), DisplayError>
-    where
-        I: IntoIterator<Item = Pixel<Rgb565>>,
-    {
-        Err(DisplayError::NotContiguous)
-    }
-
-    fn fill_contiguous<I>(&mut self, area: &Rectangle, colors: I) -> Result<(), DisplayError>
-    where
-        I: IntoIterator<Item = Rgb565>,
-    {
+    /// Takes the strip buffer itself, as a DMA-driven driver does: no
+    /// per-pixel iterator, two pixels loaded and summed a word.
+    #[inline(never)]
+    fn push_strip(&mut self, area: &Rectangle, pixels: &[Rgb565]) -> Result<(), DisplayError> {
         let start = self.clock.now();
         if area.top_left.x != 0
             || area.top_left.y != self.next_row as i32
             || area.size.width != self.size.width
             || self.next_row + area.size.height > self.size.height
+            || pixels.len() != (area.size.width * area.size.height) as usize
         {
             return Err(DisplayError::OutOfOrder);
         }
-        let n = (area.size.width * area.size.height) as usize;
         let mut sum = self.sum;
-        let mut it = colors.into_iter();
         // Two pixels a word, as a 32-bit DMA transfer moves them (rows of
         // an even width: no half word is left over).
-        for _ in 0..n / 2 {
-            let (Some(c0), Some(c1)) = (it.next(), it.next()) else {
-                return Err(DisplayError::OutOfOrder);
-            };
-            let (lo, hi): (u16, u16) = (c0.into_storage(), c1.into_storage());
+        let words = pixels.chunks_exact(2);
+        let rest = words.remainder();
+        for w in words {
+            let (lo, hi): (u16, u16) = (w[0].into_storage(), w[1].into_storage());
             sum.push_word(lo as u32 | (hi as u32) << 16);
         }
-        if n % 2 == 1 {
-            let Some(c) = it.next() else {
-                return Err(DisplayError::OutOfOrder);
-            };
+        for c in rest {
             sum.push(c.into_storage());
         }
         self.sum = sum;

@@ -7,8 +7,8 @@
 //! `StripRenderer::with_shader` with the variant's fragment shader and the
 //! whole mesh submitted again (`submit_mesh`: each triangle's vertices are
 //! transformed as it is submitted, no vertex cache, which would not fit),
-//! then the strip is pushed to the display stand-in as one
-//! `fill_contiguous`, as `StripDrawer` does for unshaded frames.
+//! then the strip is pushed to the display stand-in as
+//! one `StripSink::push_strip`, as `StripDrawer` does for unshaded frames.
 //!
 //! The split is measured as in the cubes' immediate mode: geometry is the
 //! mesh submitted to a one-row strip, times the strips (so it includes one
@@ -23,10 +23,10 @@ use crate::{
 };
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 use microraster::pixelcolor::{Rgb565, RgbColor};
+use microraster::StripSink;
 use microraster::{Attributes, Config, FragmentShader, Mat4, Mesh, StripRenderer, Submit};
 
 /// The baked model (`microraster bake`, see docs/embedded.md).
@@ -153,15 +153,13 @@ fn frame<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
     Ok(written)
 }
 
-/// Pushes rows `y0..y1` to the display as one `fill_contiguous`. Out of
-/// line, so that the push compiles (and counts) the same whatever the
-/// shading around it.
+/// Pushes rows `y0..y1` to the display as one strip (the buffer itself,
+/// as `StripDrawer` does). Out of line, so that the push compiles (and
+/// counts) the same whatever the shading around it.
 #[inline(never)]
 fn push(display: &mut HashDisplay, y0: u32, y1: u32, rows: &[Rgb565]) -> Result<(), &'static str> {
     let area = Rectangle::new(Point::new(0, y0 as i32), Size::new(WIDTH, y1 - y0));
-    display
-        .fill_contiguous(&area, rows.iter().copied())
-        .map_err(|_| "display")
+    display.push_strip(&area, rows).map_err(|_| "display")
 }
 
 #[entry]
