@@ -146,9 +146,9 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
     let mut written = 0u32;
     let mut z = z0;
     for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-        let zw = W::from_z32_16_in_range(z);
-        if zw < *dp || (LE && zw == *dp) {
-            *dp = zw;
+        let (key, old) = (W::key_in_range(z), (*dp).key());
+        if key < old || (LE && key == old) {
+            *dp = W::from_z32_16_in_range(z);
             *cp = px;
             written += 1;
         }
@@ -195,6 +195,19 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn from_z32_16_in_range(z: u64) -> Self {
         Self::from_z32((z >> 16) as u32)
     }
+    /// A `u32` that orders words as the words order: [`to_z32`] by
+    /// default. Span loops compare these in a register.
+    ///
+    /// [`to_z32`]: DepthWord::to_z32
+    #[inline(always)]
+    fn key(self) -> u32 {
+        self.to_z32()
+    }
+    /// `key(from_z32_16_in_range(z))`, for `z` in `[0, 2^48)`.
+    #[inline(always)]
+    fn key_in_range(z: u64) -> u32 {
+        Self::from_z32_16_in_range(z).key()
+    }
 }
 
 impl DepthWord for u16 {
@@ -219,6 +232,16 @@ impl DepthWord for u16 {
     #[inline(always)]
     fn from_z32_16_in_range(z: u64) -> Self {
         (z >> 32) as u16
+    }
+    /// The word itself, zero-extended (a halfword load makes it).
+    #[inline(always)]
+    fn key(self) -> u32 {
+        self as u32
+    }
+    /// The high word, already below `2^16` in range: no extension.
+    #[inline(always)]
+    fn key_in_range(z: u64) -> u32 {
+        (z >> 32) as u32
     }
 }
 
