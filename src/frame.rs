@@ -248,6 +248,11 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         };
         let mut stats = RenderStats::default();
         for t in tris {
+            // Rows outside the strip cost two compares here, not the
+            // dispatch and checks of `draw` (which would draw nothing).
+            if (t.max_y as u32) < y0 || (t.min_y as u32) >= y1 {
+                continue;
+            }
             stats.pixels_written += draw::<S, N, C, D, F>(t, &mut strip, fragment) as u64;
         }
         stats
