@@ -60,6 +60,15 @@ pub trait DepthBuffer {
     /// 16 bits and cheap on cores without a double-precision FPU.
     const WIDE: bool;
 
+    /// `F`, the fraction bits of the fixed-point depth `Z32.F` that spans
+    /// step ([`DepthBuffer::flat_span`]): 16 by default and for `u32`
+    /// buffers, 0 for `u16` buffers, whose 16 kept bits leave whole `Z32`
+    /// units 16 bits to spare (the stepping error stays below 1/8 of a
+    /// `u16` LSB over 2^14 pixels) and which then step in one 32-bit
+    /// register on a 32-bit core. (No default: a buffer that forwards
+    /// [`DepthBuffer::flat_span`] to another must state the same `F`.)
+    const FRAC: u32;
+
     /// The number of depth values held, or `None` without a buffer.
     fn depth_len(&self) -> Option<usize>;
 
@@ -68,8 +77,9 @@ pub trait DepthBuffer {
     fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool;
 
     /// Draws a span of one flat colour: pixels `start..start + len`, where
-    /// pixel `start + n` has depth `Z32 = clamp(z0 + n * dz) >> 16` (`z0`,
-    /// `dz` in `Z32.16`). Returns the pixels written. The default tests
+    /// pixel `start + n` has depth `Z32 = clamp(z0 + n * dz, 0, top) >> F`
+    /// (`z0`, `dz` in `Z32.F`, `F` = [`DepthBuffer::FRAC`], `top = 2^(32 +
+    /// F) - 1`; the sum wraps as `i64`). Returns the pixels written. The default tests
     /// pixel by pixel; buffers override it with branch-free loops the
     /// compiler can vectorize.
     #[allow(clippy::too_many_arguments)]
@@ -107,7 +117,7 @@ fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
     let mut written = 0;
     let mut z = z0;
     for (n, cp) in c.iter_mut().enumerate() {
-        if buf.test_and_set(start + n, z32_of(z), func, write) {
+        if buf.test_and_set(start + n, z32_of(z, B::FRAC), func, write) {
             *cp = px;
             written += 1;
         }
@@ -116,25 +126,28 @@ fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
     written
 }
 
-/// Whether `z0 + n * dz` lies in `[0, 2^48)` (the `Z32.16` range, where
-/// [`z32_of`] clamps nothing) for every `n < len`, so the stepped values are
-/// the exact ones: both ends are in range and the steps are small enough
-/// that no sum wraps (`|dz| < 2^40`, `len <= 2^16`: `|n dz| < 2^56`); a
-/// linear function in range at both ends is in range between them.
+/// Whether `z0 + n * dz` lies in `[0, 2^(32 + frac))` (the `Z32.F` range,
+/// where [`z32_of`] clamps nothing) for every `n < len`, so the stepped
+/// values are the exact ones: both ends are in range and the steps are
+/// small enough that no sum wraps (`|dz| < 2^40`, `len <= 2^16`: `|n dz| <
+/// 2^56`); a linear function in range at both ends is in range between
+/// them.
 #[inline]
-fn in_range_throughout(z0: i64, dz: i64, len: usize) -> bool {
-    const TOP: i64 = 1 << 48;
+fn in_range_throughout(z0: i64, dz: i64, len: usize, frac: u32) -> bool {
+    let top: i64 = 1 << (32 + frac);
     if len == 0 || len > 1 << 16 || dz.unsigned_abs() >= 1 << 40 {
         return false;
     }
     let last = z0 + dz * (len as i64 - 1);
-    (0..TOP).contains(&z0) && (0..TOP).contains(&last)
+    (0..top).contains(&z0) && (0..top).contains(&last)
 }
 
 /// The flat-span loop of [`DepthBuffer::flat_span`] for `Less` (`LE =
 /// false`) or `LessEqual` with writes, where [`in_range_throughout`] holds:
-/// `z` is never clamped, so the word is [`DepthWord::from_z32_16_in_range`]
-/// of the wrapping `u64` sum (an add with carry on a 32-bit core).
+/// `z` is never clamped, so the word is [`DepthWord::from_fixed_in_range`]
+/// of the wrapping sum: a `u64` for `Z32.16` (an add with carry on a 32-bit
+/// core), a `u32` for `Z32.0` (`u16` buffers), exact because every value
+/// is below `2^32`.
 #[inline(always)]
 fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
     c: &mut [C],
@@ -144,25 +157,38 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
     px: C,
 ) -> u32 {
     let mut written = 0u32;
-    let mut z = z0;
-    for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-        let (key, old) = (W::key_in_range(z), (*dp).key());
-        if key < old || (LE && key == old) {
-            *dp = W::from_z32_16_in_range(z);
-            *cp = px;
-            written += 1;
+    if W::FRAC == 0 {
+        let (mut z, dz) = (z0 as u32, dz as u32);
+        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+            let (key, old) = (W::key_in_range(z as u64), (*dp).key());
+            if key < old || (LE && key == old) {
+                *dp = W::from_fixed_in_range(z as u64);
+                *cp = px;
+                written += 1;
+            }
+            z = z.wrapping_add(dz);
         }
-        z = z.wrapping_add(dz);
+    } else {
+        let mut z = z0;
+        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+            let (key, old) = (W::key_in_range(z), (*dp).key());
+            if key < old || (LE && key == old) {
+                *dp = W::from_fixed_in_range(z);
+                *cp = px;
+                written += 1;
+            }
+            z = z.wrapping_add(dz);
+        }
     }
     written
 }
 
-/// `Z32` of a `Z32.16` value (clamped). Spans step `z` by `dz` with
-/// wrapping additions: the same integers as `z0 + n * dz`, without the
-/// 64-bit multiply.
+/// `Z32` of a `Z32.F` value `z` (`F = frac`, clamped). Spans step `z` by
+/// `dz` with wrapping additions: the same integers as `z0 + n * dz`,
+/// without the 64-bit multiply.
 #[inline(always)]
-pub(crate) fn z32_of(z: i64) -> u32 {
-    (z.clamp(0, (1i64 << 48) - 1) >> 16) as u32
+pub(crate) fn z32_of(z: i64, frac: u32) -> u32 {
+    (z.clamp(0, (1i64 << (32 + frac)) - 1) >> frac) as u32
 }
 
 /// A depth-buffer word: `u16` (the top 16 bits of `Z32`) or `u32` (`Z32`).
@@ -183,17 +209,20 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn from_z32(z: u32) -> Self;
     /// The word as `Z32` (a `u16` gives its value times `2^16`).
     fn to_z32(self) -> u32;
-    /// The word for a `Z32.16` depth, clamped to `[0, 1]`: the same as
+    /// `F`, the fraction bits of the depth spans step for buffers of this
+    /// word (`Z32.F`, see [`DepthBuffer::FRAC`]): 16, or 0 for `u16`.
+    const FRAC: u32 = 16;
+    /// The word for a `Z32.F` depth, clamped to `[0, 1]`: the same as
     /// `from_z32` of the clamped `Z32`, in fewer operations.
     #[inline(always)]
-    fn from_z32_16(z: i64) -> Self {
-        Self::from_z32(z32_of(z))
+    fn from_fixed(z: i64) -> Self {
+        Self::from_z32(z32_of(z, Self::FRAC))
     }
-    /// [`from_z32_16`](DepthWord::from_z32_16) of a value already in
-    /// `[0, 2^48)`, which needs no clamp: a shift.
+    /// [`from_fixed`](DepthWord::from_fixed) of a value already in
+    /// `[0, 2^(32 + F))`, which needs no clamp: a shift.
     #[inline(always)]
-    fn from_z32_16_in_range(z: u64) -> Self {
-        Self::from_z32((z >> 16) as u32)
+    fn from_fixed_in_range(z: u64) -> Self {
+        Self::from_z32((z >> Self::FRAC) as u32)
     }
     /// A `u32` that orders words as the words order: [`to_z32`] by
     /// default. Span loops compare these in a register.
@@ -203,10 +232,10 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn key(self) -> u32 {
         self.to_z32()
     }
-    /// `key(from_z32_16_in_range(z))`, for `z` in `[0, 2^48)`.
+    /// `key(from_fixed_in_range(z))`, for `z` in `[0, 2^(32 + F))`.
     #[inline(always)]
     fn key_in_range(z: u64) -> u32 {
-        Self::from_z32_16_in_range(z).key()
+        Self::from_fixed_in_range(z).key()
     }
 }
 
@@ -222,26 +251,29 @@ impl DepthWord for u16 {
     fn to_z32(self) -> u32 {
         (self as u32) << 16
     }
-    /// `clamp(z, 0, 2^48 - 1) >> 32` is `clamp(z >> 32, 0, 2^16 - 1)`
-    /// (flooring is monotone): one 32-bit saturation of the high word.
+    /// Whole `Z32` units: 16 bits below the kept ones.
+    const FRAC: u32 = 0;
+    /// `clamp(z, 0, 2^32 - 1) >> 16` is `clamp(z >> 16, 0, 2^16 - 1)`
+    /// (flooring is monotone).
     #[inline(always)]
-    fn from_z32_16(z: i64) -> Self {
-        ((z >> 32).clamp(0, 0xffff)) as u16
+    fn from_fixed(z: i64) -> Self {
+        ((z >> 16).clamp(0, 0xffff)) as u16
     }
-    /// The high word.
+    /// The top half of `Z32`.
     #[inline(always)]
-    fn from_z32_16_in_range(z: u64) -> Self {
-        (z >> 32) as u16
+    fn from_fixed_in_range(z: u64) -> Self {
+        (z >> 16) as u16
     }
     /// The word itself, zero-extended (a halfword load makes it).
     #[inline(always)]
     fn key(self) -> u32 {
         self as u32
     }
-    /// The high word, already below `2^16` in range: no extension.
+    /// The top half of `Z32`, already below `2^16` in range: no
+    /// extension.
     #[inline(always)]
     fn key_in_range(z: u64) -> u32 {
-        (z >> 32) as u32
+        (z >> 16) as u32
     }
 }
 
@@ -265,6 +297,7 @@ impl DepthWord for u32 {
 impl<W: DepthWord> DepthBuffer for [W] {
     const ENABLED: bool = true;
     const WIDE: bool = W::WIDE;
+    const FRAC: u32 = W::FRAC;
 
     #[inline(always)]
     fn flat_span<C: Copy>(
@@ -291,14 +324,14 @@ impl<W: DepthWord> DepthBuffer for [W] {
         if cfg!(target_pointer_width = "64") {
             // Branch-free, so the compiler can vectorize it (SSE/AVX).
             for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-                let zw = W::from_z32_16(z);
+                let zw = W::from_fixed(z);
                 let pass = zw < *dp || (le && zw == *dp);
                 *dp = if pass { zw } else { *dp };
                 *cp = if pass { px } else { *cp };
                 written += pass as u32;
                 z = z.wrapping_add(dz);
             }
-        } else if in_range_throughout(z0, dz, len) {
+        } else if in_range_throughout(z0, dz, len, W::FRAC) {
             // Microcontrollers have no vectors to fill: store only where
             // the test passes (the same results, fewer instructions). The
             // span's depth never leaves [0, 2^48), so no clamp: the word is
@@ -310,7 +343,7 @@ impl<W: DepthWord> DepthBuffer for [W] {
             };
         } else {
             for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-                let zw = W::from_z32_16(z);
+                let zw = W::from_fixed(z);
                 if zw < *dp || (le && zw == *dp) {
                     *dp = zw;
                     *cp = px;
@@ -346,6 +379,7 @@ impl<W: DepthWord> DepthBuffer for [W] {
 impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
     const ENABLED: bool = true;
     const WIDE: bool = W::WIDE;
+    const FRAC: u32 = W::FRAC;
 
     #[inline]
     fn flat_span<C: Copy>(
@@ -379,6 +413,7 @@ pub struct NoDepth;
 impl DepthBuffer for NoDepth {
     const ENABLED: bool = false;
     const WIDE: bool = false;
+    const FRAC: u32 = 0;
 
     fn flat_span<C: Copy>(
         &mut self,
@@ -420,7 +455,7 @@ mod tests {
     /// the 64-bit host never runs inside `flat_span`) writes what the
     /// pixel-by-pixel loop writes wherever `in_range_throughout` admits a
     /// span, and that test admits only spans whose every value is in
-    /// `[0, 2^48)`.
+    /// `[0, 2^(32 + F))`.
     fn unclamped_matches<W: DepthWord>(z0: i64, dz: i64, len: usize, seed: u64, le: bool) {
         let stored: std::vec::Vec<W> = (0..len as u64)
             .map(|n| {
@@ -435,11 +470,14 @@ mod tests {
         };
         let (mut d_ref, mut c_ref) = (stored.clone(), std::vec![0u8; len]);
         let want = flat_span_each(&mut d_ref[..], &mut c_ref, 0, len, z0, dz, func, true, 1u8);
-        if !in_range_throughout(z0, dz, len) {
+        if !in_range_throughout(z0, dz, len, W::FRAC) {
             return;
         }
         for n in 0..len as i64 {
-            assert!((0..1i64 << 48).contains(&(z0 + n * dz)), "n {n}");
+            assert!(
+                (0..1i64 << (32 + W::FRAC)).contains(&(z0 + n * dz)),
+                "n {n}"
+            );
         }
         let (mut d, mut c) = (stored, std::vec![0u8; len]);
         let got = if le {
@@ -466,23 +504,59 @@ mod tests {
             seed in any::<u64>(),
             le in any::<bool>(),
         ) {
-            unclamped_matches::<u16>(z0, dz, len, seed, le);
             unclamped_matches::<u32>(z0, dz, len, seed, le);
         }
+
+        /// The same for `u16` buffers, whose spans step `Z32.0`: starts
+        /// around `[0, 2^32)` and its ends.
+        #[test]
+        fn unclamped_span_equals_clamped_z32(
+            z0 in prop_oneof![0i64..1 << 32, -(1i64 << 12)..1 << 12, (1i64 << 32) - (1 << 12)..(1i64 << 32) + (1 << 12), any::<i64>()],
+            dz in prop_oneof![-(1i64 << 18)..1 << 18, -(1i64 << 26)..1 << 26, -4i64..4, any::<i64>()],
+            len in 1usize..300,
+            seed in any::<u64>(),
+            le in any::<bool>(),
+        ) {
+            unclamped_matches::<u16>(z0, dz, len, seed, le);
+        }
+    }
+
+    /// An array buffer reads its span depths as the slice does (the same
+    /// `Z32.F`): a forwarding impl with another `FRAC` would write other
+    /// depths.
+    #[test]
+    fn array_and_slice_spans_agree() {
+        fn check<W: DepthWord>() {
+            let (z0, dz) = (3i64 << (W::FRAC + 28), -(5i64 << (W::FRAC + 20)));
+            let mut a = [W::FAR; 64];
+            let mut b = [W::FAR; 64];
+            let (mut ca, mut cb) = ([0u8; 64], [0u8; 64]);
+            let na = a.flat_span(&mut ca, 3, 50, z0, dz, DepthFunc::Less, true, 1);
+            let nb = b[..].flat_span(&mut cb, 3, 50, z0, dz, DepthFunc::Less, true, 1);
+            assert_eq!((na, a, ca), (nb, b, cb));
+            assert_eq!(na, 50);
+            assert_eq!(<[W; 64] as DepthBuffer>::FRAC, <[W] as DepthBuffer>::FRAC);
+            assert_eq!(a[3].to_z32(), W::from_z32(3 << 28).to_z32());
+        }
+        check::<u16>();
+        check::<u32>();
     }
 
     #[test]
     fn in_range_edges() {
-        let top = 1i64 << 48;
-        assert!(in_range_throughout(0, 0, 1));
-        assert!(in_range_throughout(top - 1, 0, 1));
-        assert!(!in_range_throughout(top, 0, 1));
-        assert!(!in_range_throughout(-1, 0, 1));
-        assert!(in_range_throughout(top - 10, -1, 1 << 16));
-        assert!(!in_range_throughout(5, -1, 7));
-        assert!(!in_range_throughout(0, 1, (1 << 16) + 1));
-        assert!(!in_range_throughout(0, 1 << 40, 2));
-        assert!(!in_range_throughout(0, 0, 0));
+        for frac in [0, 16] {
+            let top = 1i64 << (32 + frac);
+            let r = |z0, dz, len| in_range_throughout(z0, dz, len, frac);
+            assert!(r(0, 0, 1));
+            assert!(r(top - 1, 0, 1));
+            assert!(!r(top, 0, 1));
+            assert!(!r(-1, 0, 1));
+            assert!(r(top - 10, -1, 1 << 16));
+            assert!(!r(5, -1, 7));
+            assert!(!r(0, 1, (1 << 16) + 1));
+            assert!(!r(0, 1 << 40, 2));
+            assert!(!r(0, 0, 0));
+        }
     }
 
     #[test]

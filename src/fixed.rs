@@ -10,7 +10,7 @@
 //! | `Sub<S>` | `i32` | window coordinate in units of `2^-S` pixel (S = [`SUBPIXEL_BITS`] 8 by default, or 4) | `|v| <= COORD_LIMIT = 2^28` |
 //! | edge value | `i64` | twice the signed area of (edge, point) in `Sub<S>^2` units | `|e| < 2^59` |
 //! | `Z32` | `u32` | window depth `[0, 1]` scaled by `2^32`, saturated to `u32::MAX` | `0 ..= 2^32 - 1` |
-//! | `Z32.16` | `i64` | interpolated depth: `Z32` with 16 more fraction bits | `0 ..= 2^48 - 1` at covered pixels |
+//! | `Z32.F` | `i64` | interpolated depth: `Z32` with `F` more fraction bits (`F` = 16 for `u32` depth buffers, 0 for `u16`) | `0 ..= 2^(32+F) - 1` at covered pixels |
 //!
 //! Ranges and why they hold:
 //! - The frame is at most [`MAX_DIMENSION`] = 16384 pixels a side, so a pixel
@@ -102,9 +102,11 @@ fn round_to_coord(v: f32) -> Option<i32> {
 /// `x as i64` (truncation toward zero, saturating, NaN gives 0) without the
 /// library call a 32-bit core makes for it (`__aeabi_f2lz`, about 60
 /// instructions with Rust's saturation around it on a Cortex-M4F): below
-/// `2^31` the hardware `f32 -> i32` conversion, above it the integer
+/// `2^31` the hardware `f32 -> i32` conversion, up to `2^32` the `u32`
+/// one (the spans of `u16` depth buffers start in whole `Z32` units), above
+/// it the integer
 /// significand shifted into place (an `f32` that large is an integer). The
-/// rasterizer converts each span's start depth (`Z32.16`, up to `2^48`)
+/// rasterizer converts each span's start depth (`Z32.F`, up to `2^48`)
 /// this way. Equal to `as` for every `f32` (tests: every exponent, the
 /// boundaries, random bit patterns; the exhaustive run is ignored by
 /// default).
@@ -126,6 +128,10 @@ pub(crate) fn f32_as_i64_by_parts(x: f32) -> i64 {
     // |x| < 2^31 (biased exponent below 127 + 31): exact in i32.
     if exp < 158 {
         return x as i32 as i64;
+    }
+    // 2^31 <= x < 2^32: exact in u32 (the upper half of `Z32`).
+    if exp == 158 && bits >> 31 == 0 {
+        return x as u32 as i64;
     }
     // |x| >= 2^63, infinities and NaN: what `as` saturates to.
     if exp >= 190 {

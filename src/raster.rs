@@ -24,7 +24,10 @@
 //! the exact edge values as `Z0 + (Z1 - Z0) E1 / area + (Z2 - Z0) E2 / area`
 //! at the start of each run of pixels (a row's first covered pixel for
 //! small triangles, every `RESYNC` pixels of a span) and stepped by its
-//! gradient in between; spans step it in `Z32.16` integers. The float
+//! gradient in between; spans step it in `Z32.F` integers: `Z32` with
+//! `F` = [`DepthBuffer::FRAC`] fraction bits, 16 for `u32` buffers and 0
+//! for `u16` buffers (whole `Z32` units are 2^-16 of their LSB; either way
+//! the stepping error stays below 1/8 LSB over 2^14 pixels). The float
 //! is `f64` for `u32` buffers: each term is at most `2^32` at a covered
 //! pixel, so the error is far below one `Z32` LSB and the written value is
 //! the floor of the exact plane value, or one off only where that value
@@ -259,8 +262,9 @@ trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self>
     fn recip(self) -> Self;
     /// Saturating, flooring conversion (NaN gives 0).
     fn to_u32(self) -> u32;
-    /// `self * 2^16`, rounded half away from zero, saturating.
-    fn to_fixed16(self) -> i64;
+    /// `self * 2^frac` (`frac` 0 or 16: `Z32.F` from `Z32`), rounded half
+    /// away from zero, saturating.
+    fn to_fixed(self, frac: u32) -> i64;
 }
 
 macro_rules! impl_real {
@@ -288,8 +292,8 @@ macro_rules! impl_real {
                 self as u32
             }
             #[inline(always)]
-            fn to_fixed16(self) -> i64 {
-                let q = self * 65536.0;
+            fn to_fixed(self, frac: u32) -> i64 {
+                let q = if frac == 16 { self * 65536.0 } else { self };
                 $to_i64(q + if q >= 0.0 { 0.5 } else { -0.5 })
             }
         }
@@ -314,7 +318,8 @@ struct Shader<R, const N: usize> {
     k2: R,
     /// Depth change per pixel.
     dz: R,
-    /// The same in `Z32.16`, rounded (saturating).
+    /// The same in `Z32.F` (`F` = [`DepthBuffer::FRAC`]), rounded
+    /// (saturating).
     dz_fixed: i64,
     /// Unbiased edge value = biased value - bias.
     bias: [i64; 3],
@@ -366,7 +371,7 @@ impl<R: Real, const N: usize> Shader<R, N> {
             k1,
             k2,
             dz,
-            dz_fixed: dz.to_fixed16(),
+            dz_fixed: dz.to_fixed(D::FRAC),
             bias: [edges[0].bias, edges[1].bias, edges[2].bias],
             dv,
             dw,
@@ -590,7 +595,7 @@ fn draw_in<
             && edges[1].clip_span(&mut lo, &mut hi)
             && edges[2].clip_span(&mut lo, &mut hi);
         if covered && !shader.smooth {
-            // Flat span: one colour, depth stepped in Z32.16 from the span's
+            // Flat span: one colour, depth stepped in Z32.F from the span's
             // exact start (error below 1/8 LSB over 2^14 pixels), in the
             // depth buffer's branch-free loop.
             let e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
@@ -601,7 +606,7 @@ fn draw_in<
                 strip.color,
                 base + lo,
                 hi - lo + 1,
-                z0.to_fixed16(),
+                z0.to_fixed(D::FRAC),
                 shader.dz_fixed,
                 strip.depth_func,
                 strip.depth_write,
@@ -610,16 +615,17 @@ fn draw_in<
         } else if covered {
             let mut e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
             let mut acc = shader.start::<D, T>(t, e);
-            // Depth exactly as on a flat span (the same Z32.16 steps from
+            // Depth exactly as on a flat span (the same Z32.F steps from
             // the same start), so the written depth never depends on the
             // pixel type; varyings re-synchronise every `resync(N)` pixels.
-            let mut z = acc.z.to_fixed16();
+            let mut z = acc.z.to_fixed(D::FRAC);
             let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
             for n in lo..=hi {
                 if (n - lo).is_multiple_of(resync(N)) && n != lo {
                     shader.resync(t, e, &mut acc);
                 }
-                written += shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z), flat);
+                written +=
+                    shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z, D::FRAC), flat);
                 z = z.wrapping_add(shader.dz_fixed);
                 e[0] += edges[0].step_x;
                 e[1] += edges[1].step_x;

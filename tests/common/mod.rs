@@ -269,6 +269,7 @@ pub struct HitCounter<'a>(pub &'a mut [u32]);
 impl DepthBuffer for HitCounter<'_> {
     const ENABLED: bool = true;
     const WIDE: bool = true;
+    const FRAC: u32 = 16;
 
     fn depth_len(&self) -> Option<usize> {
         Some(self.0.len())
