@@ -64,13 +64,18 @@ impl OriginDimensions for HashDisplay {
     }
 }
 
-impl StripSink<Rgb565> for HashDisplay {
+/// Any strip pixel the display's `Rgb565` converts from (the identity for
+/// `Rgb565` itself).
+impl<P: Copy> StripSink<P> for HashDisplay
+where
+    Rgb565: From<P>,
+{
     type Error = DisplayError;
 
     /// Takes the strip buffer itself, as a DMA-driven driver does: no
     /// per-pixel iterator, two pixels loaded and summed a word.
     #[inline(never)]
-    fn push_strip(&mut self, area: &Rectangle, pixels: &[Rgb565]) -> Result<(), DisplayError> {
+    fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), DisplayError> {
         let start = self.clock.now();
         if area.top_left.x != 0
             || area.top_left.y != self.next_row as i32
@@ -86,11 +91,14 @@ impl StripSink<Rgb565> for HashDisplay {
         let words = pixels.chunks_exact(2);
         let rest = words.remainder();
         for w in words {
-            let (lo, hi): (u16, u16) = (w[0].into_storage(), w[1].into_storage());
+            let (lo, hi): (u16, u16) = (
+                Rgb565::from(w[0]).into_storage(),
+                Rgb565::from(w[1]).into_storage(),
+            );
             sum.push_word(lo as u32 | (hi as u32) << 16);
         }
-        for c in rest {
-            sum.push(c.into_storage());
+        for &c in rest {
+            sum.push(Rgb565::from(c).into_storage());
         }
         self.sum = sum;
         self.next_row += area.size.height;

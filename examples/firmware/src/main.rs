@@ -297,21 +297,22 @@ fn main() -> ! {
 
     // Where the instructions went. Set-up-once mode measures them apart in
     // the frame itself: the vertex stage and setup (once per frame), the
-    // strip clears (measured on one strip, done once per strip), the rest
+    // strip clears (an empty frame through the same drawer), the rest
     // rasterization. Immediate mode repeats cull, clip and setup for every
     // strip: that is estimated as the scene submitted to a one-row strip
     // (which includes that one row's pixels), times the strips.
     let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
-    let mut clock = display.clock;
-    let t = clock.now();
-    COLOR.fill(BLACK);
-    #[cfg(not(feature = "no-depth"))]
-    DEPTH.fill(DepthWord::MAX);
-    let clear_ticks = (clock.now() - t) * strips;
+    // Strip clears: the same drawer drawing an empty scene (each strip
+    // cleared, handed to an empty renderer and pushed), less its pushes.
+    let mut empty = HashDisplay::new(WIDTH, HEIGHT, display.clock);
+    let t = empty.clock.now();
+    let _ = drawer.draw(&mut empty, config, |_| {});
+    let clear_ticks = (empty.clock.now() - t) - empty.ticks;
     #[cfg(not(feature = "immediate"))]
     let geometry_ticks = setup_ticks;
     #[cfg(feature = "immediate")]
     let geometry_ticks = {
+        let clock = &mut empty.clock;
         let t = clock.now();
         let (row, rest) = COLOR.split_at_mut(WIDTH as usize);
         core::hint::black_box(rest);
