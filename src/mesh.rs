@@ -49,40 +49,37 @@ impl BoundingSphere {
     /// Whether the sphere lies entirely outside one frustum plane of the
     /// clip-space transform `mvp`, so that no vertex inside it can be seen.
     ///
-    /// Conservative for every finite input: the test is exact enough in
-    /// `f64` and is widened by a bound on the rounding of the vertex
-    /// stage itself. A vertex `p` goes to clip space in `f32` as
-    /// `c_r = Σ_j m_rj p_j` (with `p_3 = 1`), three roundings per row, so
-    /// the computed plane value `w ± x` (or `± y`, `± z`) differs from the
-    /// exact one by at most `γ3 (Σ_j (|m_3j| + |m_ij|) |p_j|)` with
-    /// `γ3 = 3u / (1 - 3u) < 4 · 2^-24`, and `|p_j| <= |c_j| + r` inside
-    /// the sphere. The object is culled only if its exact plane value
-    /// stays below minus that bound, so every vertex's computed outcode
-    /// has that plane's bit set and the per-triangle frustum test would
-    /// have culled every triangle anyway. The `f64` evaluation of the
-    /// test itself errs by about `2^-50` of the same sum, covered by the
-    /// bound's factor of 4 (not 3).
+    /// Conservative for every finite input, in `f32` (no software `f64`
+    /// on single-precision FPUs: a chunked mesh tests a sphere per chunk
+    /// and strip). A vertex `p` goes to clip space in `f32` as `c_r = Σ_j
+    /// m_rj p_j` (with `p_3 = 1`), three roundings per row, so the
+    /// computed plane value `w ± x` (or `± y`, `± z`) differs from the
+    /// exact one by at most `γ3 M` with `M = Σ_j (|m_3j| + |m_ij|) |p_j|`,
+    /// `γ3 = 3u / (1 - 3u)`, `u = 2^-24`, and `|p_j| <= |c_j| + r` inside
+    /// the sphere. This test's own `f32` evaluation errs by at most `u M`
+    /// (the plane's coefficients `m_3j ± m_ij`, rounded), `γ4 M` (the
+    /// distance of the centre) and a few `u` of the comparison, which
+    /// compares squares with a relative margin of `2^-18`; the object is
+    /// culled only if the plane value at the centre, plus `16 u M` (more
+    /// than all of those), stays below minus the sphere's reach. Then
+    /// every vertex's computed outcode has that plane's bit set and the
+    /// per-triangle frustum test would have culled every triangle anyway.
+    /// An overflow makes the bound infinite or the comparison false:
+    /// nothing is culled.
     pub fn outside_frustum(&self, mvp: &Mat4) -> bool {
         let m = mvp.rows();
-        let Some((c, r, p_abs)) = self.in_f64(mvp) else {
+        let Some((c, r, p_abs)) = self.in_f32(mvp) else {
             return false;
         };
-        let gamma = GAMMA;
         for i in 0..3 {
-            for sign in [1.0f64, -1.0] {
-                // Plane: row3 + sign * row_i (Gribb-Hartmann), exact in f64.
-                let plane: [f64; 4] =
-                    core::array::from_fn(|j| m[3][j] as f64 + sign * m[i][j] as f64);
-                let dist: f64 = (0..4).map(|j| plane[j] * c[j]).sum();
-                let n2: f64 = (0..3).map(|j| plane[j] * plane[j]).sum();
-                let err: f64 = (0..4)
-                    .map(|j| ((m[3][j] as f64).abs() + (m[i][j] as f64).abs()) * p_abs[j])
-                    .sum::<f64>()
-                    * gamma;
-                // Outside when dist + err < -r |n|: compared squared, with
-                // the margin of the square root's rounding.
-                let t = -(dist + err);
-                if t > 0.0 && t * t > r * r * n2 * (1.0 + 1e-9) {
+            for sign in [1.0f32, -1.0] {
+                // Plane: row3 + sign * row_i (Gribb-Hartmann).
+                let plane: [f32; 4] = core::array::from_fn(|j| m[3][j] + sign * m[i][j]);
+                let mag: f32 = (0..4)
+                    .map(|j| (m[3][j].abs() + m[i][j].abs()) * p_abs[j])
+                    .sum();
+                // Outside when dist + err < -r |n|.
+                if beyond(plane.map(|a| -a), c, r, mag * GAMMA) {
                     return true;
                 }
             }
@@ -91,22 +88,32 @@ impl BoundingSphere {
     }
 }
 
-/// The rounding bound of the vertex stage's rows (`γ3` and the margin of
-/// the `f64` evaluation, see [`BoundingSphere::outside_frustum`]).
-const GAMMA: f64 = 5.0 / 16_777_216.0;
+/// The rounding bound, relative to the magnitudes `M` of
+/// [`BoundingSphere::outside_frustum`] and
+/// [`BoundingSphere::outside_slab`]: the vertex stage's `γ3` plus this
+/// test's own `f32` evaluation, with room to spare.
+const GAMMA: f32 = 16.0 / 16_777_216.0;
+
+/// Whether the plane `a` exceeds `err` everywhere in the sphere (centre
+/// `c`, radius `r`): `a(c) - err > r |n|`, compared squared (no square
+/// root in `no_std`) with a relative margin of `2^-18` for the rounding of
+/// both sides. `false` on any NaN (an overflow).
+#[inline]
+fn beyond(a: [f32; 4], c: [f32; 4], r: f32, err: f32) -> bool {
+    let at_c: f32 = (0..4).map(|j| a[j] * c[j]).sum();
+    let n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    let t = at_c - err;
+    t > 0.0 && t * t > r * r * n2 * (1.0 + 1.0 / 262_144.0)
+}
 
 impl BoundingSphere {
-    /// The centre (homogeneous, in `f64`), the radius and the bound
-    /// `|p_j| <= |c_j| + r` on the coordinates of the sphere's points; `None`
-    /// unless the sphere and `mvp` are finite (then nothing is culled).
-    fn in_f64(&self, mvp: &Mat4) -> Option<([f64; 4], f64, [f64; 4])> {
-        let c = [
-            self.center.x as f64,
-            self.center.y as f64,
-            self.center.z as f64,
-            1.0,
-        ];
-        let r = self.radius as f64;
+    /// The centre (homogeneous), the radius and the bound `|p_j| <= |c_j| +
+    /// r` on the coordinates of the sphere's points (rounded up by the
+    /// margin of [`GAMMA`]); `None` unless the sphere and `mvp` are finite
+    /// (then nothing is culled).
+    fn in_f32(&self, mvp: &Mat4) -> Option<([f32; 4], f32, [f32; 4])> {
+        let c = [self.center.x, self.center.y, self.center.z, 1.0];
+        let r = self.radius;
         if !(r >= 0.0 && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
             return None;
         }
@@ -121,47 +128,31 @@ impl BoundingSphere {
     ///
     /// Conservative for every finite input, as
     /// [`BoundingSphere::outside_frustum`]: a vertex's computed `y` and
-    /// `w` each err by at most `γ3 Σ_j |m_rj| |p_j|`, and the per-triangle
-    /// test's product `w * top` adds one rounding; the object is skipped
-    /// only if the exact plane value, minus the sphere's reach, exceeds
-    /// that bound (and likewise `w` stays positive), with the same factor
-    /// of 5 (not 4) covering the `f64` evaluation.
+    /// `w` each err by at most `γ3 Σ_j |m_rj| |p_j|`, the per-triangle
+    /// test's product `w * top` adds one rounding, and this test's plane
+    /// `±(m_1j - t m_3j)` two more per coefficient; the object is skipped
+    /// only if the plane value at the centre, minus `16 u` times the sum
+    /// of those magnitudes, exceeds the sphere's reach (and likewise `w`
+    /// stays positive).
     pub fn outside_slab(&self, mvp: &Mat4, top: f32, bottom: f32) -> bool {
         let m = mvp.rows();
-        let Some((c, r, p_abs)) = self.in_f64(mvp) else {
+        let Some((c, r, p_abs)) = self.in_f32(mvp) else {
             return false;
         };
         if !(top.is_finite() && bottom.is_finite()) {
             return false;
         }
-        let gamma = GAMMA;
-        let row_err = |i: usize| -> f64 {
-            (0..4)
-                .map(|j| (m[i][j] as f64).abs() * p_abs[j])
-                .sum::<f64>()
-                * gamma
-        };
-        // Whether the plane `a` exceeds `err` everywhere in the sphere:
-        // `a(c) - err > r |n|`, compared squared (no square root in
-        // `no_std`), with the margin of the comparison's rounding.
-        let beyond = |a: [f64; 4], err: f64| -> bool {
-            let at_c: f64 = (0..4).map(|j| a[j] * c[j]).sum();
-            let n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-            let t = at_c - err;
-            t > 0.0 && t * t > r * r * n2 * (1.0 + 1e-9)
-        };
-        let w_row: [f64; 4] = core::array::from_fn(|j| m[3][j] as f64);
-        let (ew, ey) = (row_err(3), row_err(1));
+        let row_mag = |i: usize| -> f32 { (0..4).map(|j| m[i][j].abs() * p_abs[j]).sum() };
+        let (mw, my) = (row_mag(3), row_mag(1));
         // In front of the eye everywhere (the per-triangle test needs w > 0).
-        if !beyond(w_row, ew) {
+        if !beyond(m[3], c, r, mw * GAMMA) {
             return false;
         }
-        let w_max: f64 = (0..4).map(|j| w_row[j].abs() * p_abs[j]).sum();
-        for (t, sign) in [(top as f64, 1.0f64), (bottom as f64, -1.0)] {
+        for (t, sign) in [(top, 1.0f32), (bottom, -1.0)] {
             // sign * (y - t w) > 0 everywhere, beyond the rounding bound.
-            let plane: [f64; 4] = core::array::from_fn(|j| sign * (m[1][j] as f64 - t * w_row[j]));
-            let err = ey + t.abs() * (ew + w_max * gamma);
-            if beyond(plane, err) {
+            let plane: [f32; 4] = core::array::from_fn(|j| sign * (m[1][j] - t * m[3][j]));
+            let err = (my + 2.0 * t.abs() * mw) * GAMMA;
+            if beyond(plane, c, r, err) {
                 return true;
             }
         }
