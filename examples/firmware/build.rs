@@ -190,7 +190,7 @@ fn spot_model(small: bool) -> spot_scene::Model<'static> {
         ($m:ident) => {
             spot_scene::Model {
                 positions: &$m::POSITIONS,
-                indices: &$m::INDICES,
+                indices: Vec::leak(morton_order(&$m::POSITIONS, &$m::INDICES)),
                 normals: &$m::NORMALS,
                 uvs: &$m::UVS,
                 texture: &$m::TEXTURE,
@@ -221,7 +221,7 @@ struct HostFrame;
 #[cfg(feature = "spot")]
 impl spot_scene::Draw for HostFrame {
     type Out = u64;
-    fn draw<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+    fn draw<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
         self,
         mesh: &Mesh<'_, A>,
         fragment: F,
@@ -274,7 +274,98 @@ fn spot_frame(out: &std::path::Path, small: bool) -> u64 {
     }
     s.push_str("];\n");
     fs::write(out.join("spot_colors.rs"), s).unwrap();
+    fs::write(out.join("spot_chunks.rs"), spot_chunks(&model)).unwrap();
     spot_scene::draw(&model, HostFrame).unwrap()
+}
+
+/// The triangles of `indices` in Morton order of their centroids (10 bits
+/// an axis over the model's box), so that runs of consecutive triangles
+/// are compact. Stable: ties keep the baked order.
+#[cfg(feature = "spot")]
+fn morton_order(positions: &[microraster::Vec3], indices: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let centroid = |t: &[u32; 3]| {
+        let p = t.map(|i| positions[i as usize]);
+        [
+            (p[0].x + p[1].x + p[2].x) / 3.0,
+            (p[0].y + p[1].y + p[2].y) / 3.0,
+            (p[0].z + p[1].z + p[2].z) / 3.0,
+        ]
+    };
+    let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+    for t in indices {
+        let c = centroid(t);
+        for a in 0..3 {
+            lo[a] = lo[a].min(c[a]);
+            hi[a] = hi[a].max(c[a]);
+        }
+    }
+    let spread = |v: u32| {
+        let mut m = 0u32;
+        for b in 0..10 {
+            m |= ((v >> b) & 1) << (3 * b);
+        }
+        m
+    };
+    let key = |t: &[u32; 3]| {
+        let c = centroid(t);
+        let q = |a: usize| (((c[a] - lo[a]) / (hi[a] - lo[a]).max(1e-30)) * 1023.0) as u32;
+        spread(q(0)) | spread(q(1)) << 1 | spread(q(2)) << 2
+    };
+    let mut out = indices.to_vec();
+    out.sort_by_key(key);
+    out
+}
+
+/// `spot_chunks.rs`: the mesh's triangles (in Morton order, see
+/// `morton_order`; the host's frame draws them in the same order) in runs
+/// of `spot_scene::CHUNK_TRIANGLES`, each with a sphere around its
+/// vertices (`BoundingSphere::from_points`), for flash. A strip renderer
+/// skips a run whose sphere lies outside its rows before it transforms a
+/// vertex.
+#[cfg(feature = "spot")]
+fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
+    let mut s = String::from(
+        "/// Spot's triangles in runs of `CHUNK_TRIANGLES`, each with a sphere\n         /// around its vertices (build.rs).\n",
+    );
+    writeln!(
+        s,
+        "pub static INDICES: [[u32; 3]; {}] = [",
+        model.indices.len()
+    )
+    .unwrap();
+    for t in model.indices {
+        writeln!(s, "    [{}, {}, {}],", t[0], t[1], t[2]).unwrap();
+    }
+    s.push_str("];\n");
+    let chunks: Vec<_> = model
+        .indices
+        .chunks(spot_scene::CHUNK_TRIANGLES)
+        .map(|tris| {
+            let points: Vec<_> = tris
+                .iter()
+                .flatten()
+                .map(|&i| model.positions[i as usize])
+                .collect();
+            microraster::BoundingSphere::from_points(&points).unwrap()
+        })
+        .collect();
+    writeln!(
+        s,
+        "pub static CHUNKS: [microraster::BoundingSphere; {}] = [",
+        chunks.len()
+    )
+    .unwrap();
+    for b in chunks {
+        let c = b.center;
+        writeln!(
+            s,
+            "    microraster::BoundingSphere {{ center: microraster::Vec3::new({:?}, {:?}, {:?}), radius: {:?} }},",
+            c.x, c.y, c.z, b.radius
+        )
+        .unwrap();
+    }
+    s.push_str("];\n");
+    s
 }
 
 fn main() {

@@ -46,6 +46,11 @@ mod colors {
     include!(concat!(env!("OUT_DIR"), "/spot_colors.rs"));
 }
 
+/// Spot's triangles in runs with bounding spheres (build.rs).
+mod chunks {
+    include!(concat!(env!("OUT_DIR"), "/spot_chunks.rs"));
+}
+
 /// What a frame took, in SysTick ticks.
 struct Measured {
     /// Pixels written, or the error that stopped the frame.
@@ -75,7 +80,7 @@ struct Strips<'a> {
 impl Draw for Strips<'_> {
     type Out = Measured;
 
-    fn draw<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+    fn draw<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
         self,
         mesh: &Mesh<'_, A>,
         fragment: F,
@@ -109,7 +114,7 @@ impl Draw for Strips<'_> {
             fragment,
         );
         if let Ok(mut one) = one {
-            let _ = one.submit_mesh(mesh, &mvp, 0);
+            let _ = submit_chunks(&mut one, mesh, &mvp);
         }
         let one_row = clock.now() - t;
         Measured {
@@ -125,7 +130,7 @@ impl Draw for Strips<'_> {
 
 /// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
 /// push the rows. The pixels written.
-fn frame<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
+fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
     config: Config,
     mvp: &Mat4,
     color: &mut [Rgb565],
@@ -145,12 +150,34 @@ fn frame<const N: usize, A: Attributes<N>, F: FragmentShader<N> + Copy>(
         let mut strip =
             StripRenderer::<_, _, 8, N, _>::with_shader(config, y0, y1, color, depth, fragment)
                 .map_err(|_| "strip renderer")?;
-        strip.submit_mesh(mesh, mvp, 0).map_err(|_| "submit")?;
+        submit_chunks(&mut strip, mesh, mvp)?;
         written += strip.render_stats().pixels_written;
         push(display, y0, y1, color)?;
         y0 = y1;
     }
     Ok(written)
+}
+
+/// Submits `mesh` as its runs of `CHUNK_TRIANGLES` triangles, each with
+/// its sphere from `chunks::CHUNKS` (build.rs): the strip renderer skips
+/// the runs whose sphere lies outside its rows (or the view) before it
+/// transforms their vertices. Triangle ids and order are the whole mesh's.
+fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
+    strip: &mut S,
+    mesh: &Mesh<'_, A>,
+    mvp: &Mat4,
+) -> Result<(), &'static str> {
+    let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
+    for (k, (indices, bounds)) in runs.zip(chunks::CHUNKS.iter()).enumerate() {
+        let run = Mesh {
+            indices,
+            bounds: Some(*bounds),
+            ..*mesh
+        };
+        let first = (k * spot_scene::CHUNK_TRIANGLES) as u32;
+        strip.submit_mesh(&run, mvp, first).map_err(|_| "submit")?;
+    }
+    Ok(())
 }
 
 /// Pushes rows `y0..y1` to the display as one strip (the buffer itself,
@@ -174,7 +201,7 @@ fn main() -> ! {
     let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
     let model = Model {
         positions: &baked::POSITIONS,
-        indices: &baked::INDICES,
+        indices: &chunks::INDICES,
         normals: &baked::NORMALS,
         uvs: &baked::UVS,
         texture: &baked::TEXTURE,
