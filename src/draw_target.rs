@@ -530,11 +530,23 @@ mod tests {
     /// their lengths (a multiple of eight or not, equal or not).
     #[test]
     fn clear_both_fills_everything() {
-        for (nd, nc) in [(0, 0), (1, 1), (7, 7), (8, 8), (21, 21), (64, 64), (5, 9), (17, 3)] {
+        for (nd, nc) in [
+            (0, 0),
+            (1, 1),
+            (7, 7),
+            (8, 8),
+            (21, 21),
+            (64, 64),
+            (5, 9),
+            (17, 3),
+        ] {
             let mut d = vec![1u16; nd];
             let mut c = vec![2u8; nc];
             clear_both(&mut d, 7, &mut c, 9);
-            assert!(d.iter().all(|&v| v == 7) && c.iter().all(|&v| v == 9), "{nd} {nc}");
+            assert!(
+                d.iter().all(|&v| v == 7) && c.iter().all(|&v| v == 9),
+                "{nd} {nc}"
+            );
         }
     }
 

@@ -5,15 +5,19 @@
 //! decimated `baked/small/spot.rs` on the micro:bit: build.rs says which);
 //! RAM holds only the strip's colour and depth rows. Every strip gets a
 //! `StripRenderer::with_shader` with the variant's fragment shader and the
-//! whole mesh submitted again (`submit_mesh`: each triangle's vertices are
-//! transformed as it is submitted, no vertex cache, which would not fit),
-//! then the strip is pushed to the display stand-in as
-//! one `StripSink::push_strip`, as `StripDrawer` does for unshaded frames.
+//! mesh submitted again, as runs of `CHUNK_TRIANGLES` triangles in Morton
+//! order, each with its bounding sphere (build.rs writes both to flash):
+//! the renderer skips a run whose sphere lies outside the strip before
+//! transforming anything (`submit_mesh`: each triangle's vertices are
+//! transformed as it is submitted, no vertex cache, which would not fit).
+//! Then the strip is pushed to the display stand-in as one
+//! `StripSink::push_strip`, as `StripDrawer` does for unshaded frames.
 //!
 //! The split is measured as in the cubes' immediate mode: geometry is the
 //! mesh submitted to a one-row strip, times the strips (so it includes one
-//! row's pixels), the clears one strip's clear times the strips, and
-//! rasterization (with shading) the rest of the render.
+//! row's pixels; the middle row's runs, so with chunks an overestimate of
+//! the strips' average), the clears one strip's clear times the strips,
+//! and rasterization (with shading) the rest of the render.
 
 use crate::clock::Clock;
 use crate::display::HashDisplay;
