@@ -302,8 +302,12 @@ fn main() -> ! {
     // strip: that is estimated as the scene submitted to a one-row strip
     // (which includes that one row's pixels), times the strips.
     let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
-    // Strip clears: the same drawer drawing an empty scene (each strip
-    // cleared, handed to an empty renderer and pushed), less its pushes.
+    // Strip clears: the same drawer drawing an empty scene in immediate
+    // mode (each strip cleared, an empty renderer made for it, pushed),
+    // less its pushes. (Set up once, the frame makes no renderers: this
+    // overstates its clears by that, a few hundred instructions a strip.
+    // Measuring with `draw_frame` instead would give it a second call site
+    // and change how the frame itself compiles.)
     let mut empty = HashDisplay::new(WIDTH, HEIGHT, display.clock);
     let t = empty.clock.now();
     let _ = drawer.draw(&mut empty, config, |_| {});

@@ -166,6 +166,9 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
 /// its sphere from `chunks::CHUNKS` (build.rs): the strip renderer skips
 /// the runs whose sphere lies outside its rows (or the view) before it
 /// transforms their vertices. Triangle ids and order are the whole mesh's.
+/// Inlined: out of line, its frame and `submit_mesh`'s took 860 bytes more
+/// stack (`spot-phong` on the Cortex-M3 overflowed its 24 KB).
+#[inline(always)]
 fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
     strip: &mut S,
     mesh: &Mesh<'_, A>,
