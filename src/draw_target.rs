@@ -166,7 +166,7 @@ pub trait StripDepth {
     fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut Self::Rows>;
 
     /// [`StripDepth::cleared`], and `color` filled with `background`
-    /// (all of it, also where `None` is returned).
+    /// (all of it; neither is touched where `None` is returned).
     fn cleared_with<P: Copy>(
         &mut self,
         len: usize,
@@ -174,9 +174,27 @@ pub trait StripDepth {
         color: &mut [P],
         background: P,
     ) -> Option<&mut Self::Rows> {
+        let rows = self.cleared(len, z32)?;
         color.fill(background);
-        self.cleared(len, z32)
+        Some(rows)
     }
+}
+
+/// The first `len` values of `depth` set to `z32` (and `color` filled, in
+/// the same pass, when given), or `None` (nothing cleared) if fewer are
+/// held: both slice impls of [`StripDepth`].
+fn clear_prefix<'a, W: DepthWord, P: Copy>(
+    depth: &'a mut [W],
+    len: usize,
+    z32: u32,
+    color: Option<(&mut [P], P)>,
+) -> Option<&'a mut [W]> {
+    let rows = depth.get_mut(..len)?;
+    match color {
+        Some((color, background)) => clear_both(rows, W::from_z32(z32), color, background),
+        None => rows.fill(W::from_z32(z32)),
+    }
+    Some(rows)
 }
 
 /// Fills `depth` with `z` and `color` with `c` in one pass: a block of
@@ -207,9 +225,7 @@ impl<W: DepthWord> StripDepth for &mut [W] {
         Some(self.len())
     }
     fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
-        let rows = self.get_mut(..len)?;
-        rows.fill(W::from_z32(z32));
-        Some(rows)
+        clear_prefix::<W, ()>(&mut self[..], len, z32, None)
     }
     fn cleared_with<P: Copy>(
         &mut self,
@@ -218,9 +234,7 @@ impl<W: DepthWord> StripDepth for &mut [W] {
         color: &mut [P],
         background: P,
     ) -> Option<&mut [W]> {
-        let rows = self.get_mut(..len)?;
-        clear_both(rows, W::from_z32(z32), color, background);
-        Some(rows)
+        clear_prefix(&mut self[..], len, z32, Some((color, background)))
     }
 }
 
@@ -230,9 +244,7 @@ impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
         Some(N)
     }
     fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
-        let rows = self.get_mut(..len)?;
-        rows.fill(W::from_z32(z32));
-        Some(rows)
+        clear_prefix::<W, ()>(&mut self[..], len, z32, None)
     }
     fn cleared_with<P: Copy>(
         &mut self,
@@ -241,9 +253,7 @@ impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
         color: &mut [P],
         background: P,
     ) -> Option<&mut [W]> {
-        let rows = self.get_mut(..len)?;
-        clear_both(rows, W::from_z32(z32), color, background);
-        Some(rows)
+        clear_prefix(&mut self[..], len, z32, Some((color, background)))
     }
 }
 
