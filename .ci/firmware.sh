@@ -85,6 +85,36 @@ record=$root/docs/embedded.md
 tolerance_pct=${FIRMWARE_COUNT_TOLERANCE_PCT:-1}
 slack=4000
 
+# The figures of one firmware run's output `$1`, into globals: frame,
+# pixels, display, render, render_px, clears, geometry (set up
+# once, or "x N strips" estimated), raster, statics, stack, ram.
+parse_run() {
+  local out=$1
+  frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
+  pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
+  display=$(sed -n 's/^ *display push (checksum) *\([0-9]*\) .*/\1/p' "$out")
+  render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
+  render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
+  clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
+  geometry=$(sed -n -E 's/^ *geometry (x [0-9]+ strips|\(once\)) +([0-9]+) .*/\2/p' "$out")
+  raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
+  statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
+  stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
+  ram=$((statics + stack))
+}
+
+# Fails (returns 1) when the last parsed run of board `$1`, build `$2`,
+# uses more RAM than the board's budget (16 KB on the micro:bit, 24 KB on
+# the MPS2 boards).
+check_ram() {
+  local budget
+  case $1 in microbit) budget=16384 ;; *) budget=24576 ;; esac
+  if [ "$ram" -gt "$budget" ]; then
+    echo "FAIL: $1 $2 uses $ram B of RAM, over the $budget B budget"
+    return 1
+  fi
+}
+
 # check_counts BOARD FEATURES "frame push render clears geometry raster":
 # fails if any count grew by more than tolerance_pct (and more than the
 # measurement's granularity, `slack` instructions) over the row recorded
@@ -181,23 +211,8 @@ for b in "${boards[@]}"; do
       failed=1
     fi
     read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
-    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
-    pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
-    perpx=$(sed -n 's/.*per written pixel \([0-9.]*\)$/\1/p' "$out")
-    display=$(sed -n 's/^ *display push (checksum) *\([0-9]*\) .*/\1/p' "$out")
-    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
-    render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
-    clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
-    geometry=$(sed -n -E 's/^ *geometry (x [0-9]+ strips|\(once\)) +([0-9]+) .*/\2/p' "$out")
-    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
-    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
-    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
-    ram=$((statics + stack))
-    case $board in microbit) budget=16384 ;; *) budget=24576 ;; esac
-    if [ "$ram" -gt "$budget" ]; then
-      echo "FAIL: $board $name uses $ram B of RAM, over the $budget B budget"
-      failed=1
-    fi
+    parse_run "$out"
+    check_ram "$board" "$name" || failed=1
     row="| $board | $name | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |"
     rows+=("$row")
     # The counts of record: docs/embedded.md's row for this board and
@@ -283,17 +298,8 @@ for b in "${config_boards[@]}"; do
       echo "FAIL: $board $label checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
       failed=1
     fi
-    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
-    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
-    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
-    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
-    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
-    ram=$((statics + stack))
-    case $board in microbit) budget=16384 ;; *) budget=24576 ;; esac
-    if [ "$ram" -gt "$budget" ]; then
-      echo "FAIL: $board $label uses $ram B of RAM, over the $budget B budget"
-      failed=1
-    fi
+    parse_run "$out"
+    check_ram "$board" "$label" || failed=1
     config_rows+=("| $board | $label | $frame | $render | $raster | $ram |")
     check_config "$board" "$label" "$frame $render $raster" || failed=1
   done
@@ -325,22 +331,8 @@ for b in "${boards[@]}"; do
     fi
     check_linked "$board" "$v" "$elf" || failed=1
     read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
-    frame=$(sed -n 's/^instructions per frame \([0-9]*\);.*/\1/p' "$out")
-    pixels=$(sed -n 's/.*pixels written \([0-9]*\);.*/\1/p' "$out")
-    display=$(sed -n 's/^ *display push (checksum) *\([0-9]*\) .*/\1/p' "$out")
-    render=$(sed -n 's/^ *render *\([0-9]*\) (.*/\1/p' "$out")
-    render_px=$(sed -n 's/^ *render *[0-9]* (\([0-9.]*\)\/px)$/\1/p' "$out")
-    clears=$(sed -n 's/^ *strip clears *\([0-9]*\) .*/\1/p' "$out")
-    geometry=$(sed -n -E 's/^ *geometry x [0-9]+ strips +([0-9]+) .*/\1/p' "$out")
-    raster=$(sed -n 's/^ *rasterization *\([0-9]*\) .*/\1/p' "$out")
-    statics=$(sed -n 's/^ram statics \([0-9]*\) B.*/\1/p' "$out")
-    stack=$(sed -n 's/.*stack high-water \([0-9]*\) B.*/\1/p' "$out")
-    ram=$((statics + stack))
-    case $board in microbit) budget=16384 ;; *) budget=24576 ;; esac
-    if [ "$ram" -gt "$budget" ]; then
-      echo "FAIL: $board $v uses $ram B of RAM, over the $budget B budget"
-      failed=1
-    fi
+    parse_run "$out"
+    check_ram "$board" "$v" || failed=1
     spot_rows+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
     check_counts "$board" "$v" "$frame $display $render $clears $geometry $raster" || failed=1
   done

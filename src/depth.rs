@@ -336,8 +336,8 @@ impl<W: DepthWord> DepthBuffer for [W] {
         } else if in_range_throughout(z0, dz, len, W::FRAC) {
             // Microcontrollers have no vectors to fill: store only where
             // the test passes (the same results, fewer instructions). The
-            // span's depth never leaves [0, 2^48), so no clamp: the word is
-            // a shift of `z`, stepped as two 32-bit words with a carry.
+            // span's depth never leaves [0, 2^(32 + F)), so no clamp: the
+            // word is a shift of `z` (one 32-bit register for `u16`).
             return if le {
                 span_unclamped::<W, C, true>(c, d, z0 as u64, dz as u64, px)
             } else {

@@ -103,11 +103,10 @@ fn round_to_coord(v: f32) -> Option<i32> {
 /// library call a 32-bit core makes for it (`__aeabi_f2lz`, about 60
 /// instructions with Rust's saturation around it on a Cortex-M4F): below
 /// `2^31` the hardware `f32 -> i32` conversion, up to `2^32` the `u32`
-/// one (the spans of `u16` depth buffers start in whole `Z32` units), above
-/// it the integer
-/// significand shifted into place (an `f32` that large is an integer). The
-/// rasterizer converts each span's start depth (`Z32.F`, up to `2^48`)
-/// this way. Equal to `as` for every `f32` (tests: every exponent, the
+/// one (the spans of `u16` depth buffers start in whole `Z32` units),
+/// above it the integer significand shifted into place (an `f32` that
+/// large is an integer). The rasterizer converts each span's start depth
+/// (`Z32.F`, up to `2^48`) this way. Equal to `as` for every `f32` (tests: every exponent, the
 /// boundaries, random bit patterns; the exhaustive run is ignored by
 /// default).
 #[inline(always)]

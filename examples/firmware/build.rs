@@ -325,7 +325,8 @@ fn morton_order(positions: &[microraster::Vec3], indices: &[[u32; 3]]) -> Vec<[u
 #[cfg(feature = "spot")]
 fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
     let mut s = String::from(
-        "/// Spot's triangles in runs of `CHUNK_TRIANGLES`, each with a sphere\n         /// around its vertices (build.rs).\n",
+        "/// Spot's triangles in runs of `CHUNK_TRIANGLES`, each with a sphere\n\
+         /// around its vertices (build.rs).\n",
     );
     writeln!(
         s,

@@ -297,7 +297,7 @@ fn main() -> ! {
 
     // Where the instructions went. Set-up-once mode measures them apart in
     // the frame itself: the vertex stage and setup (once per frame), the
-    // strip clears (an empty frame through the same drawer), the rest
+    // strip clears (an empty scene through the same drawer), the rest
     // rasterization. Immediate mode repeats cull, clip and setup for every
     // strip: that is estimated as the scene submitted to a one-row strip
     // (which includes that one row's pixels), times the strips.
