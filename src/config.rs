@@ -148,6 +148,9 @@ pub enum Error {
     /// [`MAX_LIGHTS`](crate::shade::MAX_LIGHTS) lights, a zero or
     /// non-finite direction, or a non-finite intensity.
     InvalidLighting,
+    /// Cluster data ([`ClusterSet`](crate::cull::ClusterSet)) that does
+    /// not fit the mesh or whose tree does not tile its clusters.
+    InvalidClusters(crate::cull::ClusterFault),
 }
 
 impl core::fmt::Display for Error {
@@ -207,6 +210,15 @@ impl core::fmt::Display for Error {
                 "lighting needs at most {} lights with finite, non-zero directions and finite colours",
                 crate::shade::MAX_LIGHTS
             ),
+            Error::InvalidClusters(fault) => match fault {
+                crate::cull::ClusterFault::Cluster(i) => write!(
+                    f,
+                    "cluster {i} does not continue the triangles in order or its vertex range is out of bounds"
+                ),
+                crate::cull::ClusterFault::Node(i) => {
+                    write!(f, "cluster node {i} does not tile its clusters")
+                }
+            },
         }
     }
 }

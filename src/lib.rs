@@ -56,6 +56,7 @@
 //! | settings | `config.rs` | [`Config`], [`CullMode`], [`FrontFace`], the [`Error`]s |
 //! | vertex math | `math.rs` | [`Vec3`], [`Mat4`], the `f32` float backends |
 //! | meshes, vertex stage | `mesh.rs` | [`Mesh`], [`BoundingSphere`] (object cull), [`ProcessedVertex`] (transform, outcode, snap once per vertex) |
+//! | cluster culling | `cull.rs` | [`ClusterSet`]: back-face tests per cluster and cluster tree (culling volumes, normal cones) before any vertex is transformed |
 //! | shading | `shade.rs` | [`Attributes`] (varyings per vertex: colours, lighting per vertex, texture coordinates, normals) and [`FragmentShader`] (varyings to colour: [`VertexColor`], textures, lighting per pixel), both chosen at compile time |
 //! | submission | `pipeline.rs` | [`Submit`]: object cull, frustum cull, strip skip, then clip and setup for each triangle |
 //! | clipping | `clip.rs` | outcodes; homogeneous clipping against near, far and the guard band |
@@ -78,6 +79,7 @@
 pub mod config;
 pub mod math;
 pub mod mesh;
+pub mod cull;
 pub mod shade;
 pub mod pipeline;
 pub mod clip;
@@ -96,6 +98,7 @@ pub use bins::Bins;
 pub use clip::ClipVertex;
 pub use color::{PixelFormat, TriangleId};
 pub use config::{Config, CullMode, Error, FrontFace};
+pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest};
 pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};

@@ -18,6 +18,7 @@
 
 use crate::clip::{clip_triangle, outcode, ClipVertex};
 use crate::config::Error;
+use crate::cull::{traverse, ClusterCull, ClusterSet, Eye, Visit};
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
@@ -212,6 +213,64 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         }
         self.process_vertices(mvp, mesh.positions, cache);
         self.submit_processed_mesh(mesh, first_id, cache)
+    }
+
+    /// Like [`Submit::submit_mesh_cached`], with the mesh's clusters
+    /// tested first (see [`crate::cull`]): a cluster that is wholly
+    /// back-facing is counted in [`Stats::culled_cluster`] (or
+    /// [`Stats::culled_hierarchy`], skipped by an inner node of the tree
+    /// when `cull.hierarchy` is set) without transforming any of its
+    /// vertices; the others are processed into `cache` (at their vertex
+    /// ranges) and submitted as by `submit_mesh_cached`. The frame is the
+    /// one `submit_mesh_cached` draws, for set data that bounds its
+    /// triangles; data that does not fit the mesh is refused with
+    /// [`Error::InvalidClusters`] before anything is done. Nothing is
+    /// culled by clusters under [`CullMode::None`](crate::CullMode).
+    fn submit_clusters<A: Attributes<N>>(
+        &mut self,
+        mesh: &Mesh<'_, A>,
+        mvp: &Mat4,
+        set: &ClusterSet<'_>,
+        cull: ClusterCull,
+        first_id: u32,
+        cache: &mut [ProcessedVertex],
+    ) -> Result<(), Error> {
+        let n = check_mesh_len(mesh.indices.len())?;
+        let Some(cache) = cache.get_mut(..mesh.positions.len()) else {
+            return Err(Error::VertexCacheSize {
+                expected: mesh.positions.len(),
+                actual: cache.len(),
+            });
+        };
+        set.validate(mesh.indices.len(), mesh.positions.len())?;
+        if culled_object(&mut self.parts(), mesh, mvp, n) {
+            return Ok(());
+        }
+        let c = self.stage().config;
+        let eye = Eye::from_mvp(mvp, c.cull, c.front_face);
+        traverse(set, eye.as_ref(), cull, |v| {
+            if let Visit::Draw(a, b) = v {
+                for k in set.clusters.get(a..b).unwrap_or(&[]) {
+                    let [v0, v1] = k.vertices.map(|v| v as usize);
+                    if let (Some(p), Some(out)) =
+                        (mesh.positions.get(v0..v1), cache.get_mut(v0..v1))
+                    {
+                        self.process_vertices(mvp, p, out);
+                    }
+                }
+            }
+        });
+        let job = ClusterJob {
+            inner: ProcessedJob {
+                mesh,
+                first_id,
+                cache,
+            },
+            set,
+            eye,
+            cull,
+        };
+        run_job::<S, N, _, _>(self.parts(), &job)
     }
 
     /// The vertex stage of [`Submit::submit_mesh_cached`] alone: transforms,
@@ -482,18 +541,41 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
         stats: &mut Stats,
         sink: &mut K,
     ) {
-        let (mesh, cache) = (self.mesh, self.cache);
+        let all = 0..self.mesh.indices.len();
+        self.run_range::<S, N, K>(stage, stats, sink, all, 0..self.cache.len());
+    }
+}
+
+impl<A> ProcessedJob<'_, A> {
+    /// Runs triangles `tris` (ids and attributes as in the whole mesh),
+    /// which may use only the cache entries `verts`: an index outside
+    /// them is counted as a bad index.
+    fn run_range<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+        tris: core::ops::Range<usize>,
+        verts: core::ops::Range<usize>,
+    ) where
+        A: Attributes<N>,
+    {
+        let mesh = self.mesh;
+        let base = verts.start;
+        let cache = self.cache.get(verts).unwrap_or(&[]);
         let attrs = &mesh.attributes;
         let c = &stage.config;
         // Attribute lists as long as the mesh need no check per triangle.
-        let complete = attrs.complete(mesh.indices.len(), cache.len());
-        for (i, idx) in mesh.indices.iter().enumerate() {
+        let complete = attrs.complete(mesh.indices.len(), self.cache.len());
+        let first = tris.start;
+        for (j, idx) in mesh.indices.get(tris).unwrap_or(&[]).iter().enumerate() {
+            let i = first + j;
             let id = self.first_id.wrapping_add(i as u32);
             stats.submitted += 1;
             let (Some(a), Some(b), Some(d)) = (
-                cache.get(idx[0] as usize),
-                cache.get(idx[1] as usize),
-                cache.get(idx[2] as usize),
+                cache.get((idx[0] as usize).wrapping_sub(base)),
+                cache.get((idx[1] as usize).wrapping_sub(base)),
+                cache.get((idx[2] as usize).wrapping_sub(base)),
             ) else {
                 stats.rejected_index += 1;
                 continue;
@@ -558,6 +640,95 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
             });
             process_finite::<S, N, K>(stage, &tri, [a.code, b.code, d.code], id, stats, sink);
         }
+    }
+}
+
+struct ClusterJob<'m, A> {
+    inner: ProcessedJob<'m, A>,
+    set: &'m ClusterSet<'m>,
+    eye: Option<Eye>,
+    cull: ClusterCull,
+}
+
+impl<A> ClusterJob<'_, A> {
+    /// Calls `f(triangles, vertices)` for every cluster drawn, in order,
+    /// and `g(triangles, inner)` for every skipped run of clusters.
+    fn visit(
+        &self,
+        mut f: impl FnMut(core::ops::Range<usize>, core::ops::Range<usize>),
+        mut g: impl FnMut(u64, bool),
+    ) {
+        let clusters = self.set.clusters;
+        traverse(self.set, self.eye.as_ref(), self.cull, |v| match v {
+            Visit::Draw(a, b) => {
+                for k in clusters.get(a..b).unwrap_or(&[]) {
+                    let [t0, t1] = k.triangles.map(|v| v as usize);
+                    let [v0, v1] = k.vertices.map(|v| v as usize);
+                    f(t0..t1, v0..v1);
+                }
+            }
+            Visit::Cull(a, b, inner) => {
+                let tris = clusters
+                    .get(a..b)
+                    .unwrap_or(&[])
+                    .iter()
+                    .map(|k| u64::from(k.triangles[1].saturating_sub(k.triangles[0])))
+                    .sum();
+                g(tris, inner);
+            }
+        });
+    }
+}
+
+impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
+    fn max_pieces(&self) -> usize {
+        self.inner.max_pieces()
+    }
+
+    /// The plain path's bound, over the clusters drawn.
+    fn bound(&self, _: &Stage) -> usize {
+        let cache = self.inner.cache;
+        let code = |k: u32| cache.get(k as usize).map_or(0, |v| v.code);
+        let mut n = 0usize;
+        self.visit(
+            |tris, _| {
+                for idx in self.inner.mesh.indices.get(tris).unwrap_or(&[]) {
+                    let or = code(idx[0]) | code(idx[1]) | code(idx[2]);
+                    let k = if or & outcode::CLIP != 0 {
+                        MAX_PIECES
+                    } else {
+                        1
+                    };
+                    n = n.saturating_add(k);
+                }
+            },
+            |_, _| {},
+        );
+        n
+    }
+
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
+        let mut skipped = Stats::default();
+        self.visit(
+            |tris, verts| {
+                self.inner
+                    .run_range::<S, N, K>(stage, stats, sink, tris, verts)
+            },
+            |tris, inner| {
+                skipped.submitted += tris;
+                if inner {
+                    skipped.culled_hierarchy += tris;
+                } else {
+                    skipped.culled_cluster += tris;
+                }
+            },
+        );
+        *stats += skipped;
     }
 }
 

@@ -42,6 +42,13 @@ pub struct Stats {
     /// [`BoundingSphere::outside_slab`](crate::BoundingSphere::outside_slab):
     /// then no vertex was transformed).
     pub outside_strip: u64,
+    /// Skipped with their cluster, before any of its vertices was
+    /// transformed, by a leaf's back-face test
+    /// ([`Submit::submit_clusters`](crate::Submit::submit_clusters)).
+    pub culled_cluster: u64,
+    /// Skipped like `culled_cluster`, by an inner node of the cluster
+    /// tree (a whole subtree at once).
+    pub culled_hierarchy: u64,
 }
 
 impl Stats {
@@ -56,6 +63,8 @@ impl Stats {
             self.rejected_nonfinite,
             self.rejected_index,
             self.outside_strip,
+            self.culled_cluster,
+            self.culled_hierarchy,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
@@ -74,6 +83,8 @@ impl Stats {
             clipped: self.clipped.saturating_add(o.clipped),
             stored: self.stored.saturating_add(o.stored),
             outside_strip: self.outside_strip.saturating_add(o.outside_strip),
+            culled_cluster: self.culled_cluster.saturating_add(o.culled_cluster),
+            culled_hierarchy: self.culled_hierarchy.saturating_add(o.culled_hierarchy),
         }
     }
 }

@@ -45,9 +45,11 @@
 #![forbid(unsafe_code)]
 
 pub mod big;
+pub mod clusters;
 mod drawer;
 pub mod shading;
 
+pub use clusters::{run_clusters, ClusterInput};
 pub use shading::{run_shading, ShadeInput};
 
 use big::BigMesh;
@@ -942,6 +944,8 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         clipped: b.clipped - a.clipped,
         stored: b.stored - a.stored,
         outside_strip: b.outside_strip - a.outside_strip,
+        culled_cluster: b.culled_cluster - a.culled_cluster,
+        culled_hierarchy: b.culled_hierarchy - a.culled_hierarchy,
     }
 }
 

@@ -58,6 +58,9 @@ pub enum Command {
     /// Bake an OBJ model into Rust source for firmware (`include!`).
     #[command(after_help = BAKE_HELP)]
     Bake(BakeArgs),
+    /// Measure cluster culling (culling volumes, normal cones, flat and as a
+    /// tree) against per-triangle culling on meshes from many cameras.
+    Cull(CullArgs),
 }
 
 /// The end of `render --help`: which options each source uses.
@@ -676,6 +679,66 @@ pub struct BakeArgs {
     /// and no MTL, such as Spot).
     #[arg(long, value_name = "PNG")]
     pub texture: Option<PathBuf>,
+}
+
+/// The models `cull` measures by default (in the repository).
+pub const CULL_MODELS: [&str; 3] = [
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/models/stanford-bunny.obj"
+    ),
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/teapot.obj"),
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj"),
+];
+
+/// Options of `microraster cull`.
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct CullArgs {
+    /// OBJ models (default: the bunny, the teapot and Spot).
+    #[arg(value_name = "MODEL.obj", default_values = CULL_MODELS)]
+    pub models: Vec<PathBuf>,
+
+    /// Camera directions (a Fibonacci sphere).
+    #[arg(long, value_name = "N", default_value = "64")]
+    pub cameras: usize,
+
+    /// Camera distance from the model's centre, in bounding radii (> 1).
+    #[arg(long, value_name = "R", default_value = "2.5")]
+    pub distance: f32,
+
+    /// Frame size.
+    #[arg(long, value_name = "WxH", default_value = "320x240", value_parser = parse_size)]
+    pub size: (u32, u32),
+
+    /// Interleaved timing rounds.
+    #[arg(long, value_name = "N", default_value = "5")]
+    pub rounds: usize,
+
+    /// Vertices per cluster, at most.
+    #[arg(long, value_name = "N", default_value = "64")]
+    pub max_vertices: usize,
+
+    /// Triangles per cluster, at most (a multiple of 4).
+    #[arg(long, value_name = "N", default_value = "64")]
+    pub max_triangles: usize,
+
+    /// meshoptimizer's cone weight (0..1).
+    #[arg(long, value_name = "W", default_value = "0.5")]
+    pub cone_weight: f32,
+
+    /// The tree's cost of a node test per triangle's cost (negative: no
+    /// tree).
+    #[arg(
+        long,
+        value_name = "T",
+        default_value = "1.0",
+        allow_hyphen_values = true
+    )]
+    pub t_over_r: f64,
+
+    /// Also write the measurements as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
 }
 
 #[cfg(test)]

@@ -32,6 +32,8 @@ pub mod bench;
 pub mod bench_scenes;
 pub mod cli;
 pub mod cliptris;
+pub mod cluster;
+pub mod cull_cmd;
 pub mod image_out;
 pub mod obj;
 pub mod output;

@@ -20,6 +20,7 @@ fn main() -> ExitCode {
         #[cfg(not(feature = "report"))]
         Command::Report(_) => Err(microraster_host::NO_REPORT.to_string()),
         Command::Bake(args) => microraster_host::bake::run(&args),
+        Command::Cull(args) => microraster_host::cull_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

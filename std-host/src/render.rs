@@ -98,6 +98,10 @@ pub struct Counters {
     pub clipped: u64,
     /// Set up and stored for drawing.
     pub stored: u64,
+    /// Skipped with their cluster before transform (back-facing leaf).
+    pub culled_cluster: u64,
+    /// Skipped by an inner node of the cluster tree.
+    pub culled_hierarchy: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -112,6 +116,8 @@ impl From<&Stats> for Counters {
             rejected_index: s.rejected_index,
             clipped: s.clipped,
             stored: s.stored,
+            culled_cluster: s.culled_cluster,
+            culled_hierarchy: s.culled_hierarchy,
         }
     }
 }

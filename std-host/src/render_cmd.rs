@@ -296,6 +296,11 @@ fn nonzero(c: &Counters) -> String {
             "back-facing (or front-facing with --cull front)",
             c.culled_backface,
         ),
+        ("back-facing cluster (before transform)", c.culled_cluster),
+        (
+            "back-facing cluster tree node (before transform)",
+            c.culled_hierarchy,
+        ),
         ("degenerate", c.culled_degenerate),
         ("non-finite", c.rejected_nonfinite),
         ("index out of range", c.rejected_index),

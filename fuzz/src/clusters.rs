@@ -1,0 +1,252 @@
+//! Cluster culling from arbitrary input (`fuzz_targets/clusters.rs`): a
+//! small mesh, a cluster set that is either built honestly from it
+//! (`CullVolume::from_triangles`, `NormalCone::from_triangles`, a pairwise
+//! tree) or arbitrary (bad ranges, trees that do not tile, NaN and huge
+//! geometry), an arbitrary matrix and cull settings.
+//!
+//! Checks: no panic; `validate` refuses exactly what `submit_clusters`
+//! refuses, and a refused or failed submission writes no counter and no
+//! storage slot; the counters add up (`check_accounting`); a set whose
+//! every node never culls ([`CullVolume::NEVER`], [`NormalCone::NEVER`])
+//! stores exactly what `submit_mesh_cached` stores; and an honest set
+//! stores no triangle that `submit_mesh_cached` does not (skipping only
+//! triangles the per-triangle path drops, or, at a fraction of a subpixel,
+//! sets up with a snapped winding flipped: then only fewer pieces).
+
+use crate::{check_accounting, MatIn, F};
+use libfuzzer_sys::arbitrary::{self, Arbitrary};
+use microraster::cull::{ClusterFault, CullVolume, NormalCone};
+use microraster::prelude::Submit;
+use microraster::{
+    Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Config, CullMode, Error, Frame,
+    FrontFace, Mesh, MeshColors, ProcessedVertex, SetupTriangle, Vec3,
+};
+
+/// Raw node data.
+#[derive(Arbitrary, Clone, Debug)]
+pub struct NodeIn {
+    clusters: [u8; 2],
+    skip: u8,
+    volume: [F; 12],
+    cone: [F; 7],
+}
+
+/// The input.
+#[derive(Arbitrary, Clone, Debug)]
+pub struct ClusterInput {
+    positions: Vec<[i8; 3]>,
+    indices: Vec<[u8; 3]>,
+    /// Triangles per cluster (honest sets), 1..=16.
+    per_cluster: u8,
+    honest: bool,
+    never: bool,
+    raw_clusters: Vec<[u8; 4]>,
+    raw_nodes: Vec<NodeIn>,
+    mvp: MatIn,
+    cull: u8,
+    cw: bool,
+    test_cones: bool,
+    hierarchy: bool,
+    storage: u8,
+}
+
+fn node_from(n: &NodeIn) -> ClusterNode {
+    let v = n.volume.map(|f| f.0);
+    let c = n.cone.map(|f| f.0);
+    ClusterNode {
+        clusters: n.clusters.map(u32::from),
+        skip: u32::from(n.skip),
+        volume: CullVolume {
+            origin: [v[0], v[1], v[2]],
+            n_min: [v[3], v[4], v[5]],
+            n_max: [v[6], v[7], v[8]],
+            d_min: v[9],
+            d_max: v[10],
+            radius: v[11],
+        },
+        cone: NormalCone {
+            apex: [c[0], c[1], c[2]],
+            axis: [c[3], c[4], c[5]],
+            cutoff: c[6],
+        },
+    }
+}
+
+/// Honest clusters: runs of `per` triangles, each with its own vertices,
+/// and a pairwise tree over them.
+fn honest(
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    per: usize,
+    never: bool,
+) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<Cluster>, Vec<ClusterNode>) {
+    let (mut p, mut t, mut cl) = (Vec::new(), Vec::new(), Vec::new());
+    for run in indices.chunks(per.max(1)) {
+        let (t0, v0) = (t.len() as u32, p.len() as u32);
+        for tri in run {
+            let base = p.len() as u32;
+            for &k in tri {
+                p.push(positions.get(k as usize).copied().unwrap_or(Vec3::ZERO));
+            }
+            t.push([base, base + 1, base + 2]);
+        }
+        cl.push(Cluster {
+            triangles: [t0, t.len() as u32],
+            vertices: [v0, p.len() as u32],
+        });
+    }
+    let node = |a: usize, b: usize, p: &[Vec3], t: &[[u32; 3]]| {
+        let tris = &t[cl[a].triangles[0] as usize..cl[b - 1].triangles[1] as usize];
+        let (volume, cone) = if never {
+            (CullVolume::NEVER, NormalCone::NEVER)
+        } else {
+            (
+                CullVolume::from_triangles(p, tris, [0.0; 3]),
+                NormalCone::from_triangles(p, tris),
+            )
+        };
+        ClusterNode {
+            clusters: [a as u32, b as u32],
+            skip: 0,
+            volume,
+            cone,
+        }
+    };
+    let mut nodes = Vec::new();
+    let mut a = 0;
+    while a < cl.len() {
+        if a + 1 < cl.len() {
+            let i = nodes.len();
+            nodes.push(node(a, a + 2, &p, &t));
+            nodes.push(ClusterNode {
+                skip: (i + 2) as u32,
+                ..node(a, a + 1, &p, &t)
+            });
+            nodes.push(ClusterNode {
+                skip: (i + 3) as u32,
+                ..node(a + 1, a + 2, &p, &t)
+            });
+            nodes[i].skip = (i + 3) as u32;
+            a += 2;
+        } else {
+            let i = nodes.len();
+            nodes.push(ClusterNode {
+                skip: (i + 1) as u32,
+                ..node(a, a + 1, &p, &t)
+            });
+            a += 1;
+        }
+    }
+    (p, t, cl, nodes)
+}
+
+/// Runs one input.
+pub fn run_clusters(input: &ClusterInput) {
+    let positions: Vec<Vec3> = input
+        .positions
+        .iter()
+        .take(64)
+        .map(|c| Vec3::new(c[0] as f32 / 16.0, c[1] as f32 / 16.0, c[2] as f32 / 16.0))
+        .collect();
+    let indices: Vec<[u32; 3]> = input
+        .indices
+        .iter()
+        .take(64)
+        .map(|t| t.map(u32::from))
+        .collect();
+    let (p, t, clusters, nodes) = if input.honest || input.never {
+        honest(
+            &positions,
+            &indices,
+            usize::from(input.per_cluster % 16) + 1,
+            input.never,
+        )
+    } else {
+        let cl = input
+            .raw_clusters
+            .iter()
+            .take(32)
+            .map(|c| Cluster {
+                triangles: [c[0], c[1]].map(u32::from),
+                vertices: [c[2], c[3]].map(u32::from),
+            })
+            .collect();
+        let nodes = input.raw_nodes.iter().take(32).map(node_from).collect();
+        (positions, indices, cl, nodes)
+    };
+    let set = ClusterSet {
+        clusters: &clusters,
+        nodes: &nodes,
+    };
+    let colors: Vec<_> = (0..t.len())
+        .map(|i| microraster::pixelcolor::Rgb888::new(i as u8, 7, 9))
+        .collect();
+    let mesh = Mesh {
+        positions: &p,
+        indices: &t,
+        attributes: MeshColors::PerTriangle(&colors),
+        bounds: None,
+    };
+    let mut config = Config::new(64, 48);
+    config.cull = [CullMode::Back, CullMode::Front, CullMode::None][usize::from(input.cull % 3)];
+    config.front_face = if input.cw {
+        FrontFace::Cw
+    } else {
+        FrontFace::Ccw
+    };
+    let cull = ClusterCull {
+        test: if input.test_cones {
+            ClusterTest::Cones
+        } else {
+            ClusterTest::Volumes
+        },
+        hierarchy: input.hierarchy,
+    };
+    let mvp = input.mvp.matrix();
+    let valid = set.validate(t.len(), p.len());
+    if input.honest || input.never {
+        assert_eq!(valid, Ok(()), "an honest set is valid");
+    }
+
+    // Reference: per-triangle culling.
+    let mut st_ref = vec![SetupTriangle::EMPTY; t.len() * 7 + 1];
+    let mut reference = Frame::<8>::with_subpixel_bits(config, &mut st_ref).expect("valid size");
+    let mut cache = vec![ProcessedVertex::default(); p.len()];
+    reference
+        .submit_mesh_cached(&mesh, &mvp, 0, &mut cache)
+        .expect("room for every piece");
+
+    let room = usize::from(input.storage) % (t.len() * 7 + 2);
+    let mut st = vec![SetupTriangle::EMPTY; room];
+    let mut frame = Frame::<8>::with_subpixel_bits(config, &mut st).expect("valid size");
+    let before = frame.stats();
+    let r = frame.submit_clusters(&mesh, &mvp, &set, cull, 0, &mut cache);
+    let after = frame.stats();
+    match (r, valid) {
+        (Err(Error::InvalidClusters(f)), Err(Error::InvalidClusters(g))) => {
+            assert_eq!(f, g);
+            assert_eq!(before, after, "a refused set counts nothing");
+            assert!(frame.triangles().is_empty());
+            let _: ClusterFault = f;
+        }
+        (Err(Error::StorageFull { .. }), Ok(())) => {
+            assert_eq!(before, after, "a failed submission counts nothing");
+            assert!(frame.triangles().is_empty());
+        }
+        (Ok(()), Ok(())) => {
+            check_accounting(&before, &after, t.len() as u64);
+            let (got, want) = (frame.triangles(), reference.triangles());
+            if input.never || config.cull == CullMode::None {
+                assert_eq!(after, reference.stats(), "nothing culled by clusters");
+                assert_eq!(got, want);
+            } else if input.honest {
+                // Every stored piece is one the reference stores, in order.
+                let mut it = want.iter();
+                for g in got {
+                    assert!(it.any(|w| w == g), "a piece the reference does not store");
+                }
+            }
+        }
+        (r, v) => panic!("submit_clusters {r:?} but validate {v:?}"),
+    }
+}

@@ -1,0 +1,798 @@
+//! Cluster culling: skipping groups of triangles before any of their
+//! vertices is transformed.
+//!
+//! Design note: an offline step (the host's `cluster` module, or a build
+//! script) splits a mesh into [`Cluster`]s, contiguous runs of its
+//! triangles whose vertices are a contiguous range of its positions, and
+//! arranges [`ClusterNode`]s over them in a pre-order tree: node `i`
+//! covers clusters `clusters[0]..clusters[1]` and its subtree ends at node
+//! `skip` (a leaf has `skip == i + 1`; a flat set is all leaves). Every
+//! node carries two conservative back-face tests, both evaluated per frame
+//! from the eye, found in object space from the model-view-projection
+//! matrix alone ([`Eye::from_mvp`]):
+//!
+//! - a **culling volume** ([`CullVolume`], the lecture's clustered
+//!   back-face culling): with unit normals `n_i`, a local origin `c`, the
+//!   component-wise bounds `m' <= n_i <= m` and `d_min <= n_i . (p_i - c)
+//!   <= d_max`, every triangle's facing value is bounded above by
+//!   `comb(m', m; t) . t - d_min` and below by `comb(m, m'; t) . t - d_max`
+//!   with `t = e - c`: below zero the node is wholly back-facing, above
+//!   zero wholly front-facing (the hierarchy then stops testing);
+//! - a **normal cone** ([`NormalCone`], meshoptimizer's meshlet cone):
+//!   wholly back-facing when the direction from the eye to the apex lies
+//!   within the cone's cutoff of its axis.
+//!
+//! The rasterizer culls by the sign of the snapped area, in fixed point;
+//! these tests decide in `f32` on object-space geometry. So that a rounded
+//! or snapped triangle is never skipped when the per-triangle path would
+//! draw it, both tests demand a margin: every skipped triangle is seen at
+//! least [`MARGIN`] (as the sine of the angle) past edge-on, far beyond
+//! the `f32` rounding of the tests (below `2^-20` relatively), and a node
+//! with a zero-area triangle (no normal) is never culled. A triangle that
+//! far past edge-on flips its snapped winding only when it is a fraction
+//! of a subpixel in size; the property tests check frames byte-identical
+//! to per-triangle culling over random cameras.
+//!
+//! Bad data (ranges out of order or out of bounds, a tree whose subtrees
+//! do not tile the clusters) is refused by [`ClusterSet::validate`] with
+//! [`Error::InvalidClusters`] before anything is drawn; geometric data
+//! that does not bound its triangles cannot be detected at run time and is
+//! the offline step's responsibility (the host checks it when it builds).
+
+// `!(a < b)` is meant: it is true for NaN, which must never cull. The
+// loops over the three axes index several arrays in step.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
+use crate::config::{CullMode, Error, FrontFace};
+use crate::math::{Mat4, Vec3};
+
+/// The least sine of the angle past edge-on at which a skipped triangle
+/// is seen (`2^-8`, about 0.22°).
+pub const MARGIN: f32 = 1.0 / 256.0;
+
+/// Relative allowance for the `f32` evaluation of the tests (`2^-18`).
+const ROUNDING: f32 = 1.0 / 262_144.0;
+
+/// A run of a mesh's triangles and the positions they use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Cluster {
+    /// Triangles `triangles[0]..triangles[1]` of the mesh.
+    pub triangles: [u32; 2],
+    /// The positions `vertices[0]..vertices[1]` they index; a triangle
+    /// indexing outside is counted in [`Stats::rejected_index`](crate::Stats).
+    pub vertices: [u32; 2],
+}
+
+/// The lecture's culling volume of a set of triangles (object space).
+///
+/// `n_min`/`n_max` bound the components of the triangles' unit normals
+/// (`(p1 - p0) x (p2 - p0)`, normalized), `d_min`/`d_max` bound
+/// `n . (p - origin)` over the triangles' vertices, and `radius` bounds
+/// `|p - origin|`. `d_min > d_max` (as in [`CullVolume::NEVER`]) marks a
+/// set the test must never cull.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CullVolume {
+    /// The local origin `c`.
+    pub origin: [f32; 3],
+    /// `m'`: component-wise minimum of the unit normals.
+    pub n_min: [f32; 3],
+    /// `m`: component-wise maximum of the unit normals.
+    pub n_max: [f32; 3],
+    /// The least `n . (p - c)`.
+    pub d_min: f32,
+    /// The greatest `n . (p - c)`.
+    pub d_max: f32,
+    /// The greatest `|p - c|`.
+    pub radius: f32,
+}
+
+impl CullVolume {
+    /// A volume that never culls.
+    pub const NEVER: CullVolume = CullVolume {
+        origin: [0.0; 3],
+        n_min: [-1.0; 3],
+        n_max: [1.0; 3],
+        d_min: 1.0,
+        d_max: -1.0,
+        radius: 0.0,
+    };
+
+    /// How the triangles face the eye `e` (see [`Eye`]).
+    pub fn facing(&self, e: &Eye) -> Facing {
+        let vals = [
+            self.origin[0],
+            self.origin[1],
+            self.origin[2],
+            self.n_min[0],
+            self.n_min[1],
+            self.n_min[2],
+            self.n_max[0],
+            self.n_max[1],
+            self.n_max[2],
+            self.d_min,
+            self.d_max,
+            self.radius,
+        ];
+        if !(self.d_min <= self.d_max) || !vals.iter().all(|v| v.is_finite()) {
+            return Facing::Mixed;
+        }
+        let k = e.k;
+        let mut t = [0.0f32; 3];
+        let (mut upper, mut lower, mut t1, mut c1) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+        for a in 0..3 {
+            t[a] = e.sign * (e.xyz[a] - e.w * self.origin[a]);
+            let (hi, lo) = if t[a] > 0.0 {
+                (self.n_max[a], self.n_min[a])
+            } else {
+                (self.n_min[a], self.n_max[a])
+            };
+            upper += hi * t[a];
+            lower += lo * t[a];
+            t1 += t[a].abs();
+            c1 += self.origin[a].abs();
+        }
+        let (dk_hi, dk_lo) = if k >= 0.0 {
+            (k * self.d_min, k * self.d_max)
+        } else {
+            (k * self.d_max, k * self.d_min)
+        };
+        upper -= dk_hi;
+        lower -= dk_lo;
+        let delta = MARGIN * (t1 + k.abs() * self.radius) + ROUNDING * (e.xyz1 + k.abs() * c1);
+        if upper < -delta {
+            Facing::Back
+        } else if lower > delta {
+            Facing::Front
+        } else {
+            Facing::Mixed
+        }
+    }
+}
+
+/// meshoptimizer's normal cone of a set of triangles: every triangle is
+/// back-facing when `dot(normalize(apex - e), axis) >= cutoff`. A
+/// `cutoff` of 1 or more never culls.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NormalCone {
+    /// The apex.
+    pub apex: [f32; 3],
+    /// The unit axis.
+    pub axis: [f32; 3],
+    /// The sine of the cone's half angle.
+    pub cutoff: f32,
+}
+
+impl NormalCone {
+    /// A cone that never culls.
+    pub const NEVER: NormalCone = NormalCone {
+        apex: [0.0; 3],
+        axis: [0.0, 0.0, 1.0],
+        cutoff: 2.0,
+    };
+
+    /// Whether every triangle faces away from the eye `e` by the margin.
+    ///
+    /// The cone describes triangles that face away where `n . (e - p) <
+    /// 0`; that is the rasterizer's back face only for an eye in front
+    /// of the projection (`k > 0`, see [`Eye`]), so other eyes never cull.
+    pub fn back_facing(&self, e: &Eye) -> bool {
+        let ok = self.apex.iter().chain(&self.axis).all(|v| v.is_finite());
+        if !ok || !(self.cutoff < 1.0) || !(e.k > 0.0) {
+            return false;
+        }
+        let Some(p) = e.point else {
+            return false;
+        };
+        let mut g = [0.0f32; 3];
+        let (mut d, mut gg, mut p1) = (0.0f32, 0.0f32, 0.0f32);
+        for a in 0..3 {
+            g[a] = self.apex[a] - p[a];
+            d += g[a] * self.axis[a];
+            gg += g[a] * g[a];
+            p1 += p[a].abs() + self.apex[a].abs();
+        }
+        // d >= (cutoff + MARGIN) |g|, with d shrunk by the rounding of e.
+        let d = d - ROUNDING * p1;
+        let c = self.cutoff.max(0.0) + MARGIN;
+        d > 0.0 && d * d >= c * c * gg
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Building (offline: in f64, rounded outward to f32).
+
+/// `sqrt` in `f64` from the float backend's `f32` one and Newton steps
+/// (four: from micromath's few per cent to below `2^-40`).
+fn sqrt64(x: f64) -> f64 {
+    if !(x > 0.0) {
+        return 0.0;
+    }
+    let mut y = f64::from(crate::math::fx::sqrt(x as f32));
+    if !(y > 0.0) || !y.is_finite() {
+        y = 1.0;
+    }
+    for _ in 0..4 {
+        y = 0.5 * (y + x / y);
+    }
+    y
+}
+
+/// `2^-40` and `2^-30`.
+const E40: f64 = 1.0 / (1u64 << 40) as f64;
+const E30: f64 = 1.0 / (1u64 << 30) as f64;
+
+fn down(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) > v {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
+fn up(v: f64) -> f32 {
+    let f = v as f32;
+    if f64::from(f) < v {
+        f.next_up()
+    } else {
+        f
+    }
+}
+
+type V64 = [f64; 3];
+
+fn sub(a: V64, b: V64) -> V64 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: V64, b: V64) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The triangles' vertices and unit normals in `f64`; `None` for a bad
+/// index, a non-finite position or a zero-area triangle (no normal).
+fn unit_triangles<'a>(
+    positions: &'a [Vec3],
+    indices: &'a [[u32; 3]],
+) -> impl Iterator<Item = Option<([V64; 3], V64)>> + 'a {
+    indices.iter().map(move |idx| {
+        let mut p = [[0.0f64; 3]; 3];
+        for k in 0..3 {
+            let q = positions.get(idx[k] as usize)?;
+            if !q.is_finite() {
+                return None;
+            }
+            p[k] = [q.x, q.y, q.z].map(f64::from);
+        }
+        let (u, v) = (sub(p[1], p[0]), sub(p[2], p[0]));
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let len = sqrt64(dot(n, n));
+        if !(len > 0.0) || !len.is_finite() {
+            return None;
+        }
+        Some((p, n.map(|c| c / len)))
+    })
+}
+
+impl CullVolume {
+    /// The volume of the triangles `indices` (into `positions`) about the
+    /// local origin `origin`, computed in `f64` and rounded outward;
+    /// [`CullVolume::NEVER`] for no triangles, a bad index, a non-finite
+    /// position or a zero-area triangle.
+    pub fn from_triangles(
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        origin: [f32; 3],
+    ) -> CullVolume {
+        let c = origin.map(f64::from);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let (mut dmin, mut dmax, mut r2) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for t in unit_triangles(positions, indices) {
+            let Some((p, n)) = t else {
+                return CullVolume::NEVER;
+            };
+            for a in 0..3 {
+                lo[a] = lo[a].min(n[a]);
+                hi[a] = hi[a].max(n[a]);
+            }
+            for q in p {
+                let d = sub(q, c);
+                let v = dot(n, d);
+                dmin = dmin.min(v);
+                dmax = dmax.max(v);
+                r2 = r2.max(dot(d, d));
+            }
+        }
+        if indices.is_empty() || !origin.iter().all(|v| v.is_finite()) {
+            return CullVolume::NEVER;
+        }
+        // Outward by a relative 2^-40 for the f64 rounding, then to f32.
+        let slack = |v: f64, s: f64| v + s * E40 * (1.0 + v.abs());
+        CullVolume {
+            origin,
+            n_min: lo.map(|v| down(slack(v, -1.0))),
+            n_max: hi.map(|v| up(slack(v, 1.0))),
+            d_min: down(slack(dmin, -1.0) - sqrt64(r2) * E40),
+            d_max: up(slack(dmax, 1.0) + sqrt64(r2) * E40),
+            radius: up(slack(sqrt64(r2), 1.0)),
+        }
+    }
+}
+
+impl NormalCone {
+    /// meshoptimizer's cone of the triangles (`meshopt_computeClusterBounds`'
+    /// method, in `f64`): the axis is the normalized mean of the unit
+    /// normals, the cutoff the sine of the largest angle between a normal
+    /// and the axis, and the apex lies behind every triangle's plane
+    /// (`apex = centre - axis * max_i ((centre - p_i) . n_i / (axis .
+    /// n_i))`, the centre that of the bounding box). [`NormalCone::NEVER`]
+    /// where that fails (as `NEVER` for [`CullVolume::from_triangles`]),
+    /// or where the cone is wider than meshoptimizer allows (`axis . n <=
+    /// 0.1` for some normal).
+    pub fn from_triangles(positions: &[Vec3], indices: &[[u32; 3]]) -> NormalCone {
+        let mut sum = [0.0f64; 3];
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for t in unit_triangles(positions, indices) {
+            let Some((p, n)) = t else {
+                return NormalCone::NEVER;
+            };
+            for a in 0..3 {
+                sum[a] += n[a];
+                for q in p {
+                    lo[a] = lo[a].min(q[a]);
+                    hi[a] = hi[a].max(q[a]);
+                }
+            }
+        }
+        let len = sqrt64(dot(sum, sum));
+        if indices.is_empty() || !(len > 0.0) {
+            return NormalCone::NEVER;
+        }
+        let axis = sum.map(|v| v / len);
+        let centre = [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a]));
+        let (mut mindp, mut maxt) = (1.0f64, 0.0f64);
+        for (p, n) in unit_triangles(positions, indices).flatten() {
+            let dn = dot(axis, n);
+            mindp = mindp.min(dn);
+            if dn > 0.1 {
+                maxt = maxt.max(dot(sub(centre, p[0]), n) / dn);
+            }
+        }
+        if !(mindp > 0.1) {
+            return NormalCone::NEVER;
+        }
+        let apex = [0, 1, 2].map(|a| (centre[a] - axis[a] * maxt) as f32);
+        let cutoff = up(sqrt64(1.0 - mindp * mindp) * (1.0 + E30));
+        if !apex.iter().all(|v| v.is_finite()) {
+            return NormalCone::NEVER;
+        }
+        NormalCone {
+            apex,
+            axis: axis.map(|v| v as f32),
+            cutoff,
+        }
+    }
+}
+
+/// A node of a cluster tree (see the module's design note).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClusterNode {
+    /// The clusters `clusters[0]..clusters[1]` it covers.
+    pub clusters: [u32; 2],
+    /// The index of the node after its subtree (`i + 1` for a leaf).
+    pub skip: u32,
+    /// The culling volume of all its triangles.
+    pub volume: CullVolume,
+    /// The normal cone of all its triangles.
+    pub cone: NormalCone,
+}
+
+/// A mesh's clusters and the tree over them, as the offline step wrote
+/// them (plain arrays: `static`s in flash, or slices).
+#[derive(Clone, Copy, Debug)]
+pub struct ClusterSet<'a> {
+    /// Contiguous runs of the mesh's triangles, in order, covering all.
+    pub clusters: &'a [Cluster],
+    /// The tree, in pre-order.
+    pub nodes: &'a [ClusterNode],
+}
+
+/// What [`ClusterSet::validate`] found wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ClusterFault {
+    /// The clusters do not tile the mesh's triangles in order, or a
+    /// vertex range is reversed or beyond the positions.
+    Cluster(usize),
+    /// A node whose ranges do not tile the clusters in pre-order.
+    Node(usize),
+}
+
+impl ClusterSet<'_> {
+    /// Checks the structure against a mesh of `triangles` triangles and
+    /// `vertices` positions, in O(clusters + nodes): the clusters tile
+    /// `0..triangles` in order, and every traversal (stopping at any node,
+    /// or descending into any inner one) meets each cluster exactly once.
+    pub fn validate(&self, triangles: usize, vertices: usize) -> Result<(), Error> {
+        let err = |f| Err(Error::InvalidClusters(f));
+        let mut next = 0usize;
+        for (i, c) in self.clusters.iter().enumerate() {
+            let [t0, t1] = c.triangles.map(|v| v as usize);
+            let [v0, v1] = c.vertices.map(|v| v as usize);
+            if t0 != next || t1 < t0 || v1 < v0 || v1 > vertices {
+                return err(ClusterFault::Cluster(i));
+            }
+            next = t1;
+        }
+        if next != triangles {
+            return err(ClusterFault::Cluster(self.clusters.len()));
+        }
+        let n = self.nodes.len();
+        let start = |j: usize| -> usize {
+            match self.nodes.get(j) {
+                Some(node) => node.clusters[0] as usize,
+                None => self.clusters.len(),
+            }
+        };
+        if n == 0 {
+            return if self.clusters.is_empty() {
+                Ok(())
+            } else {
+                err(ClusterFault::Node(0))
+            };
+        }
+        if start(0) != 0 {
+            return err(ClusterFault::Node(0));
+        }
+        for (i, node) in self.nodes.iter().enumerate() {
+            let [a, b] = node.clusters.map(|v| v as usize);
+            let skip = node.skip as usize;
+            let ok = a < b
+                && b <= self.clusters.len()
+                && skip > i
+                && skip <= n
+                && start(skip) == b
+                && (skip == i + 1 || start(i + 1) == a);
+            if !ok {
+                return err(ClusterFault::Node(i));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How a node's triangles face the eye.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Facing {
+    /// Every triangle would be culled by winding.
+    Back,
+    /// No triangle would be culled by winding.
+    Front,
+    /// Not known.
+    Mixed,
+}
+
+/// Which test a cluster submission runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ClusterTest {
+    /// Culling volumes ([`CullVolume`]).
+    #[default]
+    Volumes,
+    /// Normal cones ([`NormalCone`]).
+    Cones,
+}
+
+/// The settings of a cluster submission.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ClusterCull {
+    /// The back-face test.
+    pub test: ClusterTest,
+    /// Test the tree top-down, stopping at a wholly back- or front-facing
+    /// node; otherwise only the leaves are tested.
+    pub hierarchy: bool,
+}
+
+/// The eye of a projection in object space, with the sign that makes its
+/// facing values positive for the triangles the rasterizer keeps.
+///
+/// For the rows `x`, `y`, `w` of the model-view-projection matrix `A`
+/// (a 3x4 matrix), `E` is the homogeneous point with `A E = 0`: `E_j =
+/// (-1)^j det(A without column j)`, `j = 1..4`, in `f64`. By
+/// Cauchy-Binet, three points `q_k = (p_k, 1)` project to window
+/// coordinates whose doubled signed NDC area is `det[A q0, A q1, A q2] /
+/// (w0 w1 w2) = -n . (E_xyz - E_w p0) / (w0 w1 w2)`, `n = (p1 - p0) x (p2 -
+/// p0)`. So with `sign` folding in the front face and the cull mode, a
+/// triangle in front of the eye is culled by winding exactly when `sign *
+/// n . (E_xyz - E_w p) < 0`; clipped pieces lie in the same plane and
+/// wind alike.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Eye {
+    /// `E_xyz`, scaled so its largest component of `E` is 1 in magnitude.
+    pub xyz: [f32; 3],
+    /// `E_w`, scaled alike.
+    pub w: f32,
+    /// `+1` or `-1`.
+    pub sign: f32,
+    /// `sign * E_w`.
+    pub k: f32,
+    /// `|E_xyz|_1`.
+    xyz1: f32,
+    /// `E_xyz / E_w`, the eye as a point, when finite.
+    pub point: Option<[f32; 3]>,
+}
+
+impl Eye {
+    /// The eye of `mvp` for a frame culling `cull` with front face
+    /// `front`; `None` where no cluster can be culled: `CullMode::None`, a
+    /// non-finite matrix, or rows `x`, `y`, `w` of rank below 3.
+    pub fn from_mvp(mvp: &Mat4, cull: CullMode, front: FrontFace) -> Option<Eye> {
+        let sign = match (cull, front) {
+            (CullMode::None, _) => return None,
+            (CullMode::Back, FrontFace::Ccw) | (CullMode::Front, FrontFace::Cw) => -1.0f32,
+            (CullMode::Back, FrontFace::Cw) | (CullMode::Front, FrontFace::Ccw) => 1.0f32,
+        };
+        if !mvp.is_finite() {
+            return None;
+        }
+        let r = [0usize, 1, 3].map(|i| {
+            let c = &mvp.cols;
+            [c[0][i], c[1][i], c[2][i], c[3][i]].map(f64::from)
+        });
+        let minor = |skip: usize| -> f64 {
+            let cols: heapless::Vec<usize, 3> = (0..4).filter(|&c| c != skip).collect();
+            let m = |i: usize, j: usize| r[i][cols[j]];
+            m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1))
+                - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
+                + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0))
+        };
+        // (-1)^j for j = 1..4: -, +, -, +.
+        let e = [-minor(0), minor(1), -minor(2), minor(3)];
+        let big = e.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !(big > 0.0) || !big.is_finite() {
+            return None;
+        }
+        let e = e.map(|v| (v / big) as f32);
+        let xyz = [e[0], e[1], e[2]];
+        let point = if e[3] != 0.0 {
+            let p = xyz.map(|v| v / e[3]);
+            p.iter().all(|v| v.is_finite()).then_some(p)
+        } else {
+            None
+        };
+        Some(Eye {
+            xyz,
+            w: e[3],
+            sign,
+            k: sign * e[3],
+            xyz1: xyz.iter().map(|v| v.abs()).sum(),
+            point,
+        })
+    }
+}
+
+impl Eye {
+    /// An eye at the object-space point `p` of a projection that does not
+    /// mirror, culling back faces with counter-clockwise front faces (the
+    /// defaults): for offline estimates such as a node's culling
+    /// probability. `None` for a non-finite point.
+    pub fn at(p: [f32; 3]) -> Option<Eye> {
+        if !p.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        Some(Eye {
+            xyz: p,
+            w: 1.0,
+            sign: 1.0,
+            k: 1.0,
+            xyz1: p.iter().map(|v| v.abs()).sum(),
+            point: Some(p),
+        })
+    }
+}
+
+impl ClusterNode {
+    /// How the node's triangles face `e` under `test`: cones tell only
+    /// back-facing from not.
+    pub fn facing(&self, e: &Eye, test: ClusterTest) -> Facing {
+        match test {
+            ClusterTest::Volumes => self.volume.facing(e),
+            ClusterTest::Cones if self.cone.back_facing(e) => Facing::Back,
+            ClusterTest::Cones => Facing::Mixed,
+        }
+    }
+}
+
+/// What a traversal decided for a run of clusters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Visit {
+    /// Draw clusters `a..b`.
+    Draw(usize, usize),
+    /// Skip clusters `a..b` (back-facing), at a leaf (`false`) or an inner
+    /// node (`true`).
+    Cull(usize, usize, bool),
+}
+
+impl ClusterSet<'_> {
+    /// The decisions [`Submit::submit_clusters`](crate::Submit::submit_clusters)
+    /// makes, in cluster order, for a set that passed
+    /// [`ClusterSet::validate`] (on any other set: some decisions, never a
+    /// panic). `eye == None` draws everything.
+    pub fn visit(&self, eye: Option<&Eye>, cull: ClusterCull, f: impl FnMut(Visit)) {
+        traverse(self, eye, cull, f);
+    }
+}
+
+/// Walks a set, calling `f` for every decision in cluster order.
+pub(crate) fn traverse(
+    set: &ClusterSet<'_>,
+    eye: Option<&Eye>,
+    cull: ClusterCull,
+    mut f: impl FnMut(Visit),
+) {
+    let Some(eye) = eye else {
+        f(Visit::Draw(0, set.clusters.len()));
+        return;
+    };
+    let mut i = 0usize;
+    while let Some(node) = set.nodes.get(i) {
+        let [a, b] = node.clusters.map(|v| v as usize);
+        // `max`: progress even on a set that was not validated.
+        let skip = (node.skip as usize).max(i + 1);
+        let leaf = skip == i + 1;
+        if !leaf && !cull.hierarchy {
+            i += 1;
+            continue;
+        }
+        match node.facing(eye, cull.test) {
+            Facing::Back => {
+                f(Visit::Cull(a, b, !leaf));
+                i = skip;
+            }
+            Facing::Front => {
+                f(Visit::Draw(a, b));
+                i = skip;
+            }
+            Facing::Mixed if leaf => {
+                f(Visit::Draw(a, b));
+                i = skip;
+            }
+            Facing::Mixed => i += 1,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Mat4, Vec3};
+
+    fn camera() -> Mat4 {
+        Mat4::perspective(1.0, 1.0, 0.5, 50.0)
+            * Mat4::look_at(
+                Vec3::new(0.0, 0.0, 5.0),
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            )
+    }
+
+    /// A volume of one triangle in the plane z = 0 with normal `nz`.
+    fn plane(nz: f32) -> CullVolume {
+        CullVolume {
+            origin: [0.0; 3],
+            n_min: [0.0, 0.0, nz],
+            n_max: [0.0, 0.0, nz],
+            d_min: 0.0,
+            d_max: 0.0,
+            radius: 1.0,
+        }
+    }
+
+    #[test]
+    fn the_eye_is_the_camera_position() {
+        let e = Eye::from_mvp(&camera(), CullMode::Back, FrontFace::Ccw).unwrap();
+        let p = e.point.unwrap();
+        assert!((p[0]).abs() < 1e-5 && (p[1]).abs() < 1e-5 && (p[2] - 5.0).abs() < 1e-4);
+        assert!(e.k > 0.0, "a camera in front of the projection has k > 0");
+        // The same facing values as the eye put there directly.
+        let at = Eye::at([0.0, 0.0, 5.0]).unwrap();
+        for nz in [1.0, -1.0] {
+            assert_eq!(plane(nz).facing(&e), plane(nz).facing(&at));
+        }
+    }
+
+    #[test]
+    fn a_plane_facing_the_eye_is_front_and_away_is_back() {
+        let e = Eye::from_mvp(&camera(), CullMode::Back, FrontFace::Ccw).unwrap();
+        assert_eq!(plane(1.0).facing(&e), Facing::Front);
+        assert_eq!(plane(-1.0).facing(&e), Facing::Back);
+        let cw = Eye::from_mvp(&camera(), CullMode::Back, FrontFace::Cw).unwrap();
+        assert_eq!(plane(1.0).facing(&cw), Facing::Back);
+        let front = Eye::from_mvp(&camera(), CullMode::Front, FrontFace::Ccw).unwrap();
+        assert_eq!(plane(1.0).facing(&front), Facing::Back);
+        assert!(Eye::from_mvp(&camera(), CullMode::None, FrontFace::Ccw).is_none());
+    }
+
+    #[test]
+    fn an_edge_on_plane_is_mixed() {
+        // The eye at z = 5 lies in the plane x = 0 of normal (1, 0, 0).
+        let e = Eye::from_mvp(&camera(), CullMode::Back, FrontFace::Ccw).unwrap();
+        let v = CullVolume {
+            n_min: [1.0, 0.0, 0.0],
+            n_max: [1.0, 0.0, 0.0],
+            ..plane(0.0)
+        };
+        assert_eq!(v.facing(&e), Facing::Mixed);
+        assert_eq!(CullVolume::NEVER.facing(&e), Facing::Mixed);
+    }
+
+    #[test]
+    fn a_cone_pointing_away_culls() {
+        let e = Eye::from_mvp(&camera(), CullMode::Back, FrontFace::Ccw).unwrap();
+        let away = NormalCone {
+            apex: [0.0; 3],
+            axis: [0.0, 0.0, -1.0],
+            cutoff: 0.5,
+        };
+        assert!(away.back_facing(&e));
+        let toward = NormalCone {
+            axis: [0.0, 0.0, 1.0],
+            ..away
+        };
+        assert!(!toward.back_facing(&e));
+        assert!(!NormalCone::NEVER.back_facing(&e));
+    }
+
+    fn node(a: u32, b: u32, skip: u32) -> ClusterNode {
+        ClusterNode {
+            clusters: [a, b],
+            skip,
+            volume: CullVolume::NEVER,
+            cone: NormalCone::NEVER,
+        }
+    }
+
+    #[test]
+    fn validation_refuses_trees_that_do_not_tile() {
+        let clusters = [
+            Cluster {
+                triangles: [0, 2],
+                vertices: [0, 4],
+            },
+            Cluster {
+                triangles: [2, 3],
+                vertices: [2, 5],
+            },
+        ];
+        let good = [node(0, 2, 3), node(0, 1, 2), node(1, 2, 3)];
+        let ok = ClusterSet {
+            clusters: &clusters,
+            nodes: &good,
+        };
+        assert_eq!(ok.validate(3, 5), Ok(()));
+        assert_eq!(
+            ok.validate(4, 5),
+            Err(Error::InvalidClusters(ClusterFault::Cluster(2)))
+        );
+        assert_eq!(
+            ok.validate(3, 4),
+            Err(Error::InvalidClusters(ClusterFault::Cluster(1)))
+        );
+        let bad_trees: [&[ClusterNode]; 5] = [
+            &[node(0, 2, 3), node(0, 1, 2), node(0, 2, 3)],
+            &[node(0, 2, 2), node(1, 2, 3)],
+            &[node(0, 1, 1), node(0, 2, 2)],
+            &[node(0, 1, 0)],
+            &[node(1, 2, 1)],
+        ];
+        for nodes in bad_trees {
+            let s = ClusterSet {
+                clusters: &clusters,
+                nodes,
+            };
+            assert!(s.validate(3, 5).is_err(), "{nodes:?}");
+        }
+    }
+}

@@ -1,0 +1,405 @@
+//! `microraster cull`: cluster culling measured against per-triangle
+//! culling on real meshes, from many cameras (the table of
+//! `docs/culling.md`).
+//!
+//! Design note: every model is clustered once ([`crate::cluster`]) and seen
+//! from `--cameras` directions (a Fibonacci sphere, `--distance` bounding
+//! radii from its centre, looking at it). For each camera every method
+//! draws the same frame, checked byte for byte against per-triangle
+//! culling of the clustered mesh. Timing rounds are interleaved: each
+//! round times every method over all cameras in turn (A B C ..., A B C
+//! ...), so drift on a shared machine spreads over all of them; the table
+//! quotes the median per-frame time over the rounds with its range. The
+//! geometry stage is the submission alone (object cull, cluster tests,
+//! transform, clip, setup into a frame); the frame adds drawing the whole
+//! frame on one thread with a `u16` depth buffer. `t/r` is measured: one
+//! node test (over the leaves and the sample eyes) against the
+//! geometry-stage time per triangle of per-triangle culling.
+
+use crate::cli::CullArgs;
+use crate::cluster::{self, ClusterOptions, ClusteredMesh};
+use microraster::cull::{Eye, Visit};
+use microraster::prelude::*;
+use microraster::{
+    BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
+    ProcessedVertex, SetupTriangle, Stats, Vec3,
+};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The methods compared, in table order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The source mesh (shared vertices), per-triangle culling.
+    Source,
+    /// The clustered mesh, per-triangle culling.
+    Clustered,
+    /// Culling volumes at the leaves.
+    Volumes,
+    /// Culling volumes, tree top-down.
+    VolumesTree,
+    /// Normal cones at the leaves.
+    Cones,
+    /// Normal cones, tree top-down.
+    ConesTree,
+}
+
+impl Method {
+    /// All, in order.
+    pub const ALL: [Method; 6] = [
+        Method::Source,
+        Method::Clustered,
+        Method::Volumes,
+        Method::VolumesTree,
+        Method::Cones,
+        Method::ConesTree,
+    ];
+
+    fn cull(self) -> Option<ClusterCull> {
+        let (test, hierarchy) = match self {
+            Method::Source | Method::Clustered => return None,
+            Method::Volumes => (ClusterTest::Volumes, false),
+            Method::VolumesTree => (ClusterTest::Volumes, true),
+            Method::Cones => (ClusterTest::Cones, false),
+            Method::ConesTree => (ClusterTest::Cones, true),
+        };
+        Some(ClusterCull { test, hierarchy })
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            Method::Source => "per triangle, source mesh",
+            Method::Clustered => "per triangle, clustered mesh",
+            Method::Volumes => "culling volumes, leaves",
+            Method::VolumesTree => "culling volumes, tree",
+            Method::Cones => "normal cones, leaves",
+            Method::ConesTree => "normal cones, tree",
+        }
+    }
+}
+
+/// One row of the table.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// The method.
+    pub method: Method,
+    /// Triangles that reached the vertex and triangle stages, per frame
+    /// (mean over the cameras).
+    pub triangles_to_transform: f64,
+    /// Share of the submitted triangles removed before transform.
+    pub removed_before_transform: f64,
+    /// Vertices transformed per frame (mean).
+    pub vertices_transformed: f64,
+    /// Triangles set up per frame (mean).
+    pub triangles_set_up: f64,
+    /// Geometry stage, ms per frame: median over the rounds, min, max.
+    pub geometry_ms: [f64; 3],
+    /// Whole frame, ms per frame: median, min, max.
+    pub frame_ms: [f64; 3],
+    /// Cameras whose frame differed from per-triangle culling (must be 0).
+    pub frames_differing: usize,
+}
+
+/// What one model measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelReport {
+    /// File name.
+    pub model: String,
+    /// Triangles of the source mesh.
+    pub triangles: usize,
+    /// Vertices of the source mesh and of the clustered one.
+    pub vertices: [usize; 2],
+    /// Clusters, inner tree nodes.
+    pub clusters: [usize; 2],
+    /// Bytes of the precomputed data (clusters and nodes).
+    pub data_bytes: usize,
+    /// The measured `t/r`.
+    pub t_over_r: f64,
+    /// The rows.
+    pub rows: Vec<Row>,
+}
+
+/// Runs the command.
+pub fn run(args: &CullArgs) -> Result<(), String> {
+    let opts = ClusterOptions {
+        max_vertices: args.max_vertices,
+        max_triangles: args.max_triangles,
+        cone_weight: args.cone_weight,
+        t_over_r: args.t_over_r,
+    };
+    let mut reports = Vec::new();
+    for path in &args.models {
+        let m = crate::obj::load_obj(path)?;
+        let positions: Vec<Vec3> = m.positions.iter().map(|&p| Vec3::from_array(p)).collect();
+        let clustered = cluster::build(&positions, &m.indices, &opts)?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        eprintln!(
+            "{name}: {} triangles, {} clusters, {} inner nodes",
+            m.indices.len(),
+            clustered.clusters.len(),
+            clustered.inner_nodes()
+        );
+        reports.push(measure(&name, &positions, &m.indices, &clustered, args)?);
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&reports).map_err(|e| e.to_string())?;
+        crate::output::write_all(&[crate::output::Output {
+            option: "--json",
+            path,
+            payload: crate::output::Payload::Raw(text.as_bytes()),
+        }])?;
+    }
+    print!("{}", markdown(&reports, args));
+    Ok(())
+}
+
+/// The cameras: `n` directions on a Fibonacci sphere, `dist` radii out.
+pub fn cameras(positions: &[Vec3], n: usize, dist: f32, aspect: f32) -> Result<Vec<Mat4>, String> {
+    let b = BoundingSphere::from_points(positions).ok_or("the model has no finite vertex")?;
+    (0..n)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - y * y).max(0.0).sqrt();
+            let phi = i as f32 * 2.399_963;
+            let eye = b.center + Vec3::new(r * phi.cos(), y, r * phi.sin()) * (dist * b.radius);
+            let view =
+                crate::scene::look_at([eye.x, eye.y, eye.z], [b.center.x, b.center.y, b.center.z])?;
+            let near = (dist - 1.0).max(0.05) * b.radius * 0.5;
+            Ok(Mat4::perspective(0.9, aspect, near, (dist + 2.0) * b.radius) * view)
+        })
+        .collect()
+}
+
+/// A mesh to submit and how.
+struct Case<'a> {
+    mesh: Mesh<'a>,
+    set: Option<(&'a ClusteredMesh, ClusterCull)>,
+}
+
+/// Submits one frame; returns its stats.
+fn submit(
+    frame: &mut Frame<'_>,
+    case: &Case<'_>,
+    mvp: &Mat4,
+    cache: &mut [ProcessedVertex],
+) -> Result<Stats, String> {
+    match case.set {
+        None => frame.submit_mesh_cached(&case.mesh, mvp, 0, cache),
+        Some((c, cull)) => frame.submit_clusters(&case.mesh, mvp, &c.set(), cull, 0, cache),
+    }
+    .map_err(|e| e.to_string())?;
+    Ok(frame.stats())
+}
+
+/// Vertices a frame transforms.
+fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
+    let Some((c, cull)) = case.set else {
+        return case.mesh.positions.len();
+    };
+    let eye = Eye::from_mvp(
+        mvp,
+        microraster::CullMode::Back,
+        microraster::FrontFace::Ccw,
+    );
+    let mut n = 0;
+    c.set().visit(eye.as_ref(), cull, |v| {
+        if let Visit::Draw(a, b) = v {
+            n += c.clusters[a..b]
+                .iter()
+                .map(|k| (k.vertices[1] - k.vertices[0]) as usize)
+                .sum::<usize>();
+        }
+    });
+    n
+}
+
+fn measure(
+    name: &str,
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    clustered: &ClusteredMesh,
+    args: &CullArgs,
+) -> Result<ModelReport, String> {
+    let (w, h) = args.size;
+    let config = Config::new(w, h);
+    let mvps = cameras(positions, args.cameras, args.distance, w as f32 / h as f32)?;
+    let white = Rgb888::new(255, 255, 255);
+    let src_colors = vec![white; indices.len()];
+    let colors: Vec<Rgb888> = clustered
+        .source_triangle
+        .iter()
+        .map(|&t| {
+            let t = t as usize;
+            Rgb888::new((t * 37) as u8, (t * 91) as u8, (t * 13) as u8)
+        })
+        .collect();
+    let source = Mesh {
+        positions,
+        indices,
+        attributes: MeshColors::PerTriangle(&src_colors),
+        bounds: None,
+    };
+    let cmesh = Mesh {
+        positions: &clustered.positions,
+        indices: &clustered.indices,
+        attributes: MeshColors::PerTriangle(&colors),
+        bounds: None,
+    };
+    let cases: Vec<Case<'_>> = Method::ALL
+        .iter()
+        .map(|m| Case {
+            mesh: if *m == Method::Source { source } else { cmesh },
+            set: m.cull().map(|c| (clustered, c)),
+        })
+        .collect();
+    let cap = clustered.indices.len().max(indices.len()) * 2 + 64;
+    let mut storage = vec![SetupTriangle::EMPTY; cap];
+    let mut cache =
+        vec![ProcessedVertex::default(); clustered.positions.len().max(positions.len())];
+    let n = (w * h) as usize;
+    let (mut color, mut depth) = (vec![Rgb888::BLACK; n], vec![u16::MAX; n]);
+
+    // Counts and the identical-frame check, once per camera.
+    let mut rows: Vec<Row> = Method::ALL
+        .iter()
+        .map(|&method| Row {
+            method,
+            triangles_to_transform: 0.0,
+            removed_before_transform: 0.0,
+            vertices_transformed: 0.0,
+            triangles_set_up: 0.0,
+            geometry_ms: [0.0; 3],
+            frame_ms: [0.0; 3],
+            frames_differing: 0,
+        })
+        .collect();
+    let cams = mvps.len().max(1) as f64;
+    for mvp in &mvps {
+        let mut want: Option<Vec<u8>> = None;
+        for (row, case) in rows.iter_mut().zip(&cases) {
+            let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
+            let s = submit(&mut frame, case, mvp, &mut cache)?;
+            color.fill(Rgb888::BLACK);
+            depth.fill(u16::MAX);
+            frame
+                .render_rows(0, h, &mut color, &mut depth[..])
+                .map_err(|e| e.to_string())?;
+            let skipped = s.culled_cluster + s.culled_hierarchy;
+            row.triangles_to_transform += (s.submitted - skipped) as f64 / cams;
+            row.removed_before_transform += skipped as f64 / s.submitted.max(1) as f64 / cams;
+            row.vertices_transformed += vertices_transformed(case, mvp) as f64 / cams;
+            row.triangles_set_up += s.stored as f64 / cams;
+            if row.method != Method::Source {
+                let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+                bytes.extend(depth.iter().flat_map(|d| d.to_le_bytes()));
+                match &want {
+                    None => want = Some(bytes),
+                    Some(w) if *w != bytes => row.frames_differing += 1,
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+
+    // Timing, interleaved rounds.
+    let rounds = args.rounds.max(1);
+    let mut geo = vec![Vec::with_capacity(rounds); cases.len()];
+    let mut full = vec![Vec::with_capacity(rounds); cases.len()];
+    for _ in 0..rounds {
+        for (k, case) in cases.iter().enumerate() {
+            let (mut g, mut f) = (0.0f64, 0.0f64);
+            for mvp in &mvps {
+                let t0 = Instant::now();
+                let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
+                submit(&mut frame, case, mvp, &mut cache)?;
+                let t1 = Instant::now();
+                color.fill(Rgb888::BLACK);
+                depth.fill(u16::MAX);
+                frame
+                    .render_rows(0, h, &mut color, &mut depth[..])
+                    .map_err(|e| e.to_string())?;
+                let t2 = Instant::now();
+                g += (t1 - t0).as_secs_f64();
+                f += (t2 - t0).as_secs_f64();
+            }
+            geo[k].push(g * 1e3 / cams);
+            full[k].push(f * 1e3 / cams);
+        }
+    }
+    for (k, row) in rows.iter_mut().enumerate() {
+        row.geometry_ms = spread(&mut geo[k]);
+        row.frame_ms = spread(&mut full[k]);
+    }
+
+    // t/r: a node test against the per-triangle geometry time.
+    let eyes = cluster::sample_eyes(&clustered.positions);
+    let leaves = &clustered.nodes;
+    let t0 = Instant::now();
+    let mut backs = 0usize;
+    for e in &eyes {
+        for node in leaves {
+            backs += usize::from(node.volume.facing(e) == microraster::cull::Facing::Back);
+        }
+    }
+    let tests = (eyes.len() * leaves.len()).max(1) as f64;
+    let t = t0.elapsed().as_secs_f64() / tests;
+    std::hint::black_box(backs);
+    let r = rows[1].geometry_ms[0] * 1e-3 / clustered.indices.len().max(1) as f64;
+    Ok(ModelReport {
+        model: name.to_string(),
+        triangles: indices.len(),
+        vertices: [positions.len(), clustered.positions.len()],
+        clusters: [clustered.clusters.len(), clustered.inner_nodes()],
+        data_bytes: clustered.data_bytes(),
+        t_over_r: t / r,
+        rows,
+    })
+}
+
+/// `[median, min, max]`.
+fn spread(v: &mut [f64]) -> [f64; 3] {
+    v.sort_by(f64::total_cmp);
+    let Some((&lo, &hi)) = v.first().zip(v.last()) else {
+        return [0.0; 3];
+    };
+    [v[v.len() / 2], lo, hi]
+}
+
+/// The tables, one per model.
+pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
+    let (w, h) = args.size;
+    let mut s = format!(
+        "{} cameras at {} radii, {w}x{h}, {} interleaved rounds, 1 thread; meshlets of at most {} vertices and {} triangles, cone weight {}, tree t/r {}\n",
+        args.cameras, args.distance, args.rounds, args.max_vertices, args.max_triangles, args.cone_weight, args.t_over_r
+    );
+    for r in reports {
+        s += &format!(
+            "\n### {}: {} triangles, {} -> {} vertices, {} clusters, {} inner nodes, {} B of culling data, measured t/r {:.3}\n\n",
+            r.model, r.triangles, r.vertices[0], r.vertices[1], r.clusters[0], r.clusters[1], r.data_bytes, r.t_over_r
+        );
+        s += "| method | triangles to transform | removed before transform | vertices transformed | set up | geometry ms (median, range) | frame ms (median, range) | frames differing |\n";
+        s += "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+        for row in &r.rows {
+            s += &format!(
+                "| {} | {:.0} | {:.1} % | {:.0} | {:.0} | {:.3} ({:.3}-{:.3}) | {:.3} ({:.3}-{:.3}) | {} |\n",
+                row.method.label(),
+                row.triangles_to_transform,
+                row.removed_before_transform * 100.0,
+                row.vertices_transformed,
+                row.triangles_set_up,
+                row.geometry_ms[0],
+                row.geometry_ms[1],
+                row.geometry_ms[2],
+                row.frame_ms[0],
+                row.frame_ms[1],
+                row.frame_ms[2],
+                if row.method == Method::Source { "-".to_string() } else { row.frames_differing.to_string() },
+            );
+        }
+    }
+    s
+}
