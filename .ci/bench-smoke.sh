@@ -64,6 +64,22 @@ run quad --scene quad --frames 5 --warmup 1
 check "$out/quad.json" "$common" 'd["pixels_written"] == 1920 * 1080' \
   'pos(d["floor"]["floor_ms"])' 'pos(d["floor"]["frame_over_floor"])'
 
+# Cluster culling's measurement (docs/culling.md), reduced: every method
+# draws the frame per-triangle culling draws, and culls.
+echo "+ microraster cull --cameras 8 --rounds 1"
+"$bin" cull --cameras 8 --rounds 1 --json "$out/cull.json" >"$out/cull.md"
+python3 - "$out/cull.json" <<'PY'
+import json, sys
+reports = json.load(open(sys.argv[1]))
+assert len(reports) == 3, reports
+for r in reports:
+    for row in r["rows"]:
+        assert row["frames_differing"] == 0, (r["model"], row)
+    culled = [row["removed_before_transform"] for row in r["rows"][2:]]
+    assert all(c > 0.2 for c in culled), (r["model"], culled)
+    print(f'{r["model"]}: removed before transform {", ".join(f"{c:.3f}" for c in culled)}')
+PY
+
 if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
   cargo bench -q -p microraster-host --features criterion --bench core --no-run
 fi

@@ -58,8 +58,13 @@ const ROUNDING: f32 = 1.0 / 262_144.0;
 pub struct Cluster {
     /// Triangles `triangles[0]..triangles[1]` of the mesh.
     pub triangles: [u32; 2],
-    /// The positions `vertices[0]..vertices[1]` they index; a triangle
-    /// indexing outside is counted in [`Stats::rejected_index`](crate::Stats).
+    /// The vertices they use: entries `vertices[0]..vertices[1]` of the
+    /// set's vertex list ([`ClusterSet::vertices`]), or, where the set has
+    /// none, the positions `vertices[0]..vertices[1]` themselves (every
+    /// cluster with its own copies). A triangle using a vertex outside is
+    /// counted in [`Stats::rejected_index`](crate::Stats) (a range of
+    /// positions) or [`Stats::rejected_nonfinite`](crate::Stats) (a list:
+    /// the vertex was not processed).
     pub vertices: [u32; 2],
 }
 
@@ -399,6 +404,13 @@ pub struct ClusterSet<'a> {
     pub clusters: &'a [Cluster],
     /// The tree, in pre-order.
     pub nodes: &'a [ClusterNode],
+    /// The positions each cluster uses (indices into the mesh's
+    /// positions; shared vertices listed by every cluster that uses
+    /// them), or empty for clusters whose vertices are contiguous ranges
+    /// of the positions. With a list, every vertex of a drawn cluster is
+    /// processed once however many clusters list it; without one, the
+    /// vertex cache needs no reset per frame.
+    pub vertices: &'a [u32],
 }
 
 /// What [`ClusterSet::validate`] found wrong.
@@ -413,7 +425,8 @@ pub enum ClusterFault {
 
 impl ClusterSet<'_> {
     /// Checks the structure against a mesh of `triangles` triangles and
-    /// `vertices` positions, in O(clusters + nodes): the clusters tile
+    /// `vertices` positions, in O(clusters + nodes) (the entries of a
+    /// vertex list are checked as they are used): the clusters tile
     /// `0..triangles` in order, and every traversal (stopping at any node,
     /// or descending into any inner one) meets each cluster exactly once.
     pub fn validate(&self, triangles: usize, vertices: usize) -> Result<(), Error> {
@@ -422,7 +435,12 @@ impl ClusterSet<'_> {
         for (i, c) in self.clusters.iter().enumerate() {
             let [t0, t1] = c.triangles.map(|v| v as usize);
             let [v0, v1] = c.vertices.map(|v| v as usize);
-            if t0 != next || t1 < t0 || v1 < v0 || v1 > vertices {
+            let limit = if self.vertices.is_empty() {
+                vertices
+            } else {
+                self.vertices.len()
+            };
+            if t0 != next || t1 < t0 || v1 < v0 || v1 > limit {
                 return err(ClusterFault::Cluster(i));
             }
             next = t1;
@@ -770,6 +788,7 @@ mod tests {
         let ok = ClusterSet {
             clusters: &clusters,
             nodes: &good,
+            vertices: &[],
         };
         assert_eq!(ok.validate(3, 5), Ok(()));
         assert_eq!(
@@ -791,6 +810,7 @@ mod tests {
             let s = ClusterSet {
                 clusters: &clusters,
                 nodes,
+                vertices: &[],
             };
             assert!(s.validate(3, 5).is_err(), "{nodes:?}");
         }

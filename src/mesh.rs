@@ -236,6 +236,14 @@ impl ProcessedVertex {
         snapped: false,
     };
 
+    /// Not processed this frame: counted as non-finite if a triangle uses
+    /// it (a cluster set whose vertex list misses one of its triangles'
+    /// vertices).
+    pub(crate) const STALE: ProcessedVertex = ProcessedVertex {
+        code: NONFINITE,
+        ..ProcessedVertex::EMPTY
+    };
+
     #[inline]
     fn new<const S: u32>(pos: Vec4, gx: f32, gy: f32, width: u32, height: u32) -> Self {
         if !pos.is_finite() {

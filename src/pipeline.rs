@@ -18,7 +18,7 @@
 
 use crate::clip::{clip_triangle, outcode, ClipVertex};
 use crate::config::Error;
-use crate::cull::{traverse, ClusterCull, ClusterSet, Eye, Visit};
+use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Eye, Visit};
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
@@ -248,18 +248,50 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         }
         let c = self.stage().config;
         let eye = Eye::from_mvp(mvp, c.cull, c.front_face);
-        traverse(set, eye.as_ref(), cull, |v| {
-            if let Visit::Draw(a, b) = v {
-                for k in set.clusters.get(a..b).unwrap_or(&[]) {
-                    let [v0, v1] = k.vertices.map(|v| v as usize);
-                    if let (Some(p), Some(out)) =
-                        (mesh.positions.get(v0..v1), cache.get_mut(v0..v1))
-                    {
-                        self.process_vertices(mvp, p, out);
+        let list = set.vertices;
+        let drawn = |f: &mut dyn FnMut(&Cluster)| {
+            traverse(set, eye.as_ref(), cull, |v| {
+                if let Visit::Draw(a, b) = v {
+                    set.clusters
+                        .get(a..b)
+                        .unwrap_or(&[])
+                        .iter()
+                        .for_each(&mut *f);
+                }
+            })
+        };
+        if list.is_empty() {
+            drawn(&mut |k| {
+                let [v0, v1] = k.vertices.map(|v| v as usize);
+                if let (Some(p), Some(out)) = (mesh.positions.get(v0..v1), cache.get_mut(v0..v1)) {
+                    self.process_vertices(mvp, p, out);
+                }
+            });
+        } else {
+            // The drawn clusters' vertices marked stale, then each
+            // processed once; no other entry is read (a triangle using
+            // one the list misses meets a stale or old entry: see
+            // `Cluster::vertices`).
+            let ids = |k: &Cluster| list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+            drawn(&mut |k| {
+                for &id in ids(k).unwrap_or(&[]) {
+                    if let Some(out) = cache.get_mut(id as usize) {
+                        *out = ProcessedVertex::STALE;
                     }
                 }
-            }
-        });
+            });
+            drawn(&mut |k| {
+                for &id in ids(k).unwrap_or(&[]) {
+                    let id = id as usize;
+                    if let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id)) {
+                        if out.code & NONFINITE != 0 {
+                            let (p, out) = (core::slice::from_ref(p), core::slice::from_mut(out));
+                            self.process_vertices(mvp, p, out);
+                        }
+                    }
+                }
+            });
+        }
         let job = ClusterJob {
             inner: ProcessedJob {
                 mesh,
@@ -663,8 +695,14 @@ impl<A> ClusterJob<'_, A> {
             Visit::Draw(a, b) => {
                 for k in clusters.get(a..b).unwrap_or(&[]) {
                     let [t0, t1] = k.triangles.map(|v| v as usize);
-                    let [v0, v1] = k.vertices.map(|v| v as usize);
-                    f(t0..t1, v0..v1);
+                    // With a vertex list, triangles index the whole cache
+                    // (entries not processed are stale: non-finite).
+                    let verts = if self.set.vertices.is_empty() {
+                        k.vertices[0] as usize..k.vertices[1] as usize
+                    } else {
+                        0..self.inner.cache.len()
+                    };
+                    f(t0..t1, verts);
                 }
             }
             Visit::Cull(a, b, inner) => {
@@ -685,9 +723,16 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
         self.inner.max_pieces()
     }
 
-    /// The plain path's bound, over the clusters drawn.
+    /// The plain path's bound, over the clusters drawn: their triangle
+    /// count where no cache entry needs clipping (one sequential pass),
+    /// else one piece or seven per triangle.
     fn bound(&self, _: &Stage) -> usize {
         let cache = self.inner.cache;
+        if !cache.iter().any(|v| v.code & outcode::CLIP != 0) {
+            let mut n = 0usize;
+            self.visit(|tris, _| n = n.saturating_add(tris.len()), |_, _| {});
+            return n;
+        }
         let code = |k: u32| cache.get(k as usize).map_or(0, |v| v.code);
         let mut n = 0usize;
         self.visit(

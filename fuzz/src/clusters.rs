@@ -40,6 +40,8 @@ pub struct ClusterInput {
     per_cluster: u8,
     honest: bool,
     never: bool,
+    shared: bool,
+    raw_list: Vec<u8>,
     raw_clusters: Vec<[u8; 4]>,
     raw_nodes: Vec<NodeIn>,
     mvp: MatIn,
@@ -72,27 +74,55 @@ fn node_from(n: &NodeIn) -> ClusterNode {
     }
 }
 
-/// Honest clusters: runs of `per` triangles, each with its own vertices,
-/// and a pairwise tree over them.
+/// Honest clusters: runs of `per` triangles, each with its own vertices
+/// or (`shared`) listing the mesh's, and a pairwise tree over them.
+type Honest = (
+    Vec<Vec3>,
+    Vec<[u32; 3]>,
+    Vec<Cluster>,
+    Vec<ClusterNode>,
+    Vec<u32>,
+);
+
 fn honest(
     positions: &[Vec3],
     indices: &[[u32; 3]],
     per: usize,
     never: bool,
-) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<Cluster>, Vec<ClusterNode>) {
-    let (mut p, mut t, mut cl) = (Vec::new(), Vec::new(), Vec::new());
-    for run in indices.chunks(per.max(1)) {
-        let (t0, v0) = (t.len() as u32, p.len() as u32);
+    shared: bool,
+) -> Honest {
+    let (mut p, mut t, mut cl, mut list) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let in_range: Vec<[u32; 3]> = indices
+        .iter()
+        .filter(|i| i.iter().all(|&k| (k as usize) < positions.len()))
+        .copied()
+        .collect();
+    if shared {
+        p = positions.to_vec();
+    }
+    for run in in_range.chunks(per.max(1)) {
+        let t0 = t.len() as u32;
+        let v0 = if shared { list.len() } else { p.len() } as u32;
         for tri in run {
+            if shared {
+                t.push(*tri);
+                for &k in tri {
+                    if !list[v0 as usize..].contains(&k) {
+                        list.push(k);
+                    }
+                }
+                continue;
+            }
             let base = p.len() as u32;
             for &k in tri {
-                p.push(positions.get(k as usize).copied().unwrap_or(Vec3::ZERO));
+                p.push(positions[k as usize]);
             }
             t.push([base, base + 1, base + 2]);
         }
+        let v1 = if shared { list.len() } else { p.len() } as u32;
         cl.push(Cluster {
             triangles: [t0, t.len() as u32],
-            vertices: [v0, p.len() as u32],
+            vertices: [v0, v1],
         });
     }
     let node = |a: usize, b: usize, p: &[Vec3], t: &[[u32; 3]]| {
@@ -137,7 +167,7 @@ fn honest(
             a += 1;
         }
     }
-    (p, t, cl, nodes)
+    (p, t, cl, nodes, list)
 }
 
 /// Runs one input.
@@ -154,13 +184,9 @@ pub fn run_clusters(input: &ClusterInput) {
         .take(64)
         .map(|t| t.map(u32::from))
         .collect();
-    let (p, t, clusters, nodes) = if input.honest || input.never {
-        honest(
-            &positions,
-            &indices,
-            usize::from(input.per_cluster % 16) + 1,
-            input.never,
-        )
+    let (p, t, clusters, nodes, list) = if input.honest || input.never {
+        let per = usize::from(input.per_cluster % 16) + 1;
+        honest(&positions, &indices, per, input.never, input.shared)
     } else {
         let cl = input
             .raw_clusters
@@ -172,11 +198,18 @@ pub fn run_clusters(input: &ClusterInput) {
             })
             .collect();
         let nodes = input.raw_nodes.iter().take(32).map(node_from).collect();
-        (positions, indices, cl, nodes)
+        let list = input
+            .raw_list
+            .iter()
+            .take(64)
+            .map(|&v| u32::from(v))
+            .collect();
+        (positions, indices, cl, nodes, list)
     };
     let set = ClusterSet {
         clusters: &clusters,
         nodes: &nodes,
+        vertices: &list,
     };
     let colors: Vec<_> = (0..t.len())
         .map(|i| microraster::pixelcolor::Rgb888::new(i as u8, 7, 9))

@@ -719,11 +719,11 @@ pub struct CullArgs {
     pub max_vertices: usize,
 
     /// Triangles per cluster, at most (a multiple of 4).
-    #[arg(long, value_name = "N", default_value = "64")]
+    #[arg(long, value_name = "N", default_value = "16")]
     pub max_triangles: usize,
 
     /// meshoptimizer's cone weight (0..1).
-    #[arg(long, value_name = "W", default_value = "0.5")]
+    #[arg(long, value_name = "W", default_value = "1.0")]
     pub cone_weight: f32,
 
     /// The tree's cost of a node test per triangle's cost (negative: no
@@ -735,6 +735,11 @@ pub struct CullArgs {
         allow_hyphen_values = true
     )]
     pub t_over_r: f64,
+
+    /// Give every cluster its own copies of its vertices (contiguous
+    /// ranges, no vertex list) instead of sharing them.
+    #[arg(long)]
+    pub copies: bool,
 
     /// Also write the measurements as JSON.
     #[arg(long, value_name = "FILE")]

@@ -4,11 +4,13 @@
 //! Design note: meshoptimizer (`meshopt::build_meshlets`) splits the mesh
 //! into meshlets of at most `max_vertices` vertices and `max_triangles`
 //! triangles, in a spatially coherent order. Every meshlet becomes one
-//! [`Cluster`] with its own copy of its vertices, so that its triangles
-//! are a contiguous run and its vertices a contiguous range: a culled
-//! cluster's vertices are never transformed, a drawn one's exactly once
-//! (shared vertices along cluster borders are transformed once per
-//! cluster drawn). Each node's culling volume takes as its local origin
+//! [`Cluster`], its triangles a contiguous run. Its vertices are either
+//! listed (shared, the default: the source's positions, a vertex list
+//! entry per meshlet vertex; a vertex is processed once a frame if any
+//! cluster using it is drawn) or copied (every cluster its own contiguous
+//! range of positions, border vertices repeated: no list, no per-frame
+//! reset of the cache, for firmware). A culled cluster's own vertices
+//! are never transformed. Each node's culling volume takes as its local origin
 //! the centre or one of the eight corners of its box, whichever gives the
 //! largest `d_min` (the lecture's choice); its cone is meshoptimizer's.
 //!
@@ -43,15 +45,20 @@ pub struct ClusterOptions {
     /// The cost of a node test over that of one triangle (`t/r`); a
     /// negative value builds no tree (leaves only).
     pub t_over_r: f64,
+    /// Share vertices between clusters through a vertex list (the
+    /// source's positions, each processed once a frame) instead of giving
+    /// every cluster its own copies (contiguous ranges, no list).
+    pub shared: bool,
 }
 
 impl Default for ClusterOptions {
     fn default() -> Self {
         ClusterOptions {
             max_vertices: 64,
-            max_triangles: 64,
-            cone_weight: 0.5,
+            max_triangles: 16,
+            cone_weight: 1.0,
             t_over_r: 1.0,
+            shared: true,
         }
     }
 }
@@ -59,8 +66,8 @@ impl Default for ClusterOptions {
 /// A mesh rebuilt as clusters, owning the arrays a [`ClusterSet`] borrows.
 #[derive(Clone, Debug, Default)]
 pub struct ClusteredMesh {
-    /// Positions, each cluster's a contiguous range (border vertices
-    /// repeated).
+    /// Positions: the source's (shared), or each cluster's a contiguous
+    /// range (border vertices repeated).
     pub positions: Vec<Vec3>,
     /// Triangles, each cluster's a contiguous run.
     pub indices: Vec<[u32; 3]>,
@@ -72,6 +79,8 @@ pub struct ClusteredMesh {
     pub clusters: Vec<Cluster>,
     /// The tree, in pre-order.
     pub nodes: Vec<ClusterNode>,
+    /// With shared vertices: the positions each cluster uses.
+    pub vertex_list: Vec<u32>,
 }
 
 impl ClusteredMesh {
@@ -80,6 +89,7 @@ impl ClusteredMesh {
         ClusterSet {
             clusters: &self.clusters,
             nodes: &self.nodes,
+            vertices: &self.vertex_list,
         }
     }
 
@@ -127,16 +137,32 @@ pub fn build(
         }
     }
     let mut out = ClusteredMesh::default();
+    if opts.shared {
+        out.positions = positions.to_vec();
+        out.source_vertex = (0..positions.len() as u32).collect();
+    }
     for m in meshlets.iter() {
-        let base = out.positions.len() as u32;
+        let base = if opts.shared {
+            out.vertex_list.len()
+        } else {
+            out.positions.len()
+        } as u32;
         let t0 = out.indices.len() as u32;
         for &v in m.vertices {
-            out.positions.push(positions[v as usize]);
-            out.source_vertex.push(v);
+            if opts.shared {
+                out.vertex_list.push(v);
+            } else {
+                out.positions.push(positions[v as usize]);
+                out.source_vertex.push(v);
+            }
         }
         for t in m.triangles.chunks_exact(3) {
             let local = [t[0], t[1], t[2]].map(u32::from);
-            out.indices.push(local.map(|k| base + k));
+            if opts.shared {
+                out.indices.push(local.map(|k| m.vertices[k as usize]));
+            } else {
+                out.indices.push(local.map(|k| base + k));
+            }
             let src = local.map(|k| m.vertices[k as usize]);
             let id = tri_of
                 .get_mut(&canonical(src))
@@ -144,16 +170,53 @@ pub fn build(
                 .ok_or("meshoptimizer returned a triangle not in the mesh")?;
             out.source_triangle.push(id);
         }
+        let end = if opts.shared {
+            out.vertex_list.len()
+        } else {
+            out.positions.len()
+        } as u32;
         out.clusters.push(Cluster {
             triangles: [t0, out.indices.len() as u32],
-            vertices: [base, out.positions.len() as u32],
+            vertices: [base, end],
         });
+    }
+    if opts.shared {
+        reorder_by_first_use(&mut out);
     }
     out.nodes = tree(&out, opts.t_over_r);
     out.set()
         .validate(out.indices.len(), out.positions.len())
         .map_err(|e| e.to_string())?;
     Ok(out)
+}
+
+/// Renumbers the positions in the order the vertex list first uses them
+/// (unused ones last), so that each cluster's vertices lie together in
+/// the cache: the triangle loop then reads what was just processed.
+fn reorder_by_first_use(m: &mut ClusteredMesh) {
+    let n = m.positions.len();
+    let mut new_of = vec![u32::MAX; n];
+    let mut order = Vec::with_capacity(n);
+    for &v in m.vertex_list.iter() {
+        if new_of[v as usize] == u32::MAX {
+            new_of[v as usize] = order.len() as u32;
+            order.push(v);
+        }
+    }
+    for v in 0..n as u32 {
+        if new_of[v as usize] == u32::MAX {
+            new_of[v as usize] = order.len() as u32;
+            order.push(v);
+        }
+    }
+    m.positions = order.iter().map(|&v| m.positions[v as usize]).collect();
+    m.source_vertex = order.iter().map(|&v| m.source_vertex[v as usize]).collect();
+    for v in m.vertex_list.iter_mut() {
+        *v = new_of[*v as usize];
+    }
+    for t in m.indices.iter_mut() {
+        *t = t.map(|v| new_of[v as usize]);
+    }
 }
 
 /// A triangle's indices rotated so the smallest is first (winding kept).

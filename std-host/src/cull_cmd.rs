@@ -108,8 +108,9 @@ pub struct ModelReport {
     pub model: String,
     /// Triangles of the source mesh.
     pub triangles: usize,
-    /// Vertices of the source mesh and of the clustered one.
-    pub vertices: [usize; 2],
+    /// Vertices of the source mesh, of the clustered one, and entries of
+    /// its vertex list.
+    pub vertices: [usize; 3],
     /// Clusters, inner tree nodes.
     pub clusters: [usize; 2],
     /// Bytes of the precomputed data (clusters and nodes).
@@ -127,6 +128,7 @@ pub fn run(args: &CullArgs) -> Result<(), String> {
         max_triangles: args.max_triangles,
         cone_weight: args.cone_weight,
         t_over_r: args.t_over_r,
+        shared: !args.copies,
     };
     let mut reports = Vec::new();
     for path in &args.models {
@@ -205,13 +207,22 @@ fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
         microraster::CullMode::Back,
         microraster::FrontFace::Ccw,
     );
+    let mut seen = vec![false; c.positions.len()];
     let mut n = 0;
     c.set().visit(eye.as_ref(), cull, |v| {
         if let Visit::Draw(a, b) = v {
-            n += c.clusters[a..b]
-                .iter()
-                .map(|k| (k.vertices[1] - k.vertices[0]) as usize)
-                .sum::<usize>();
+            for k in &c.clusters[a..b] {
+                let r = k.vertices[0] as usize..k.vertices[1] as usize;
+                if c.vertex_list.is_empty() {
+                    n += r.len();
+                    continue;
+                }
+                for &id in &c.vertex_list[r] {
+                    if !std::mem::replace(&mut seen[id as usize], true) {
+                        n += 1;
+                    }
+                }
+            }
         }
     });
     n
@@ -352,7 +363,11 @@ fn measure(
     Ok(ModelReport {
         model: name.to_string(),
         triangles: indices.len(),
-        vertices: [positions.len(), clustered.positions.len()],
+        vertices: [
+            positions.len(),
+            clustered.positions.len(),
+            clustered.vertex_list.len(),
+        ],
         clusters: [clustered.clusters.len(), clustered.inner_nodes()],
         data_bytes: clustered.data_bytes(),
         t_over_r: t / r,
@@ -373,13 +388,28 @@ fn spread(v: &mut [f64]) -> [f64; 3] {
 pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
     let (w, h) = args.size;
     let mut s = format!(
-        "{} cameras at {} radii, {w}x{h}, {} interleaved rounds, 1 thread; meshlets of at most {} vertices and {} triangles, cone weight {}, tree t/r {}\n",
-        args.cameras, args.distance, args.rounds, args.max_vertices, args.max_triangles, args.cone_weight, args.t_over_r
+        "{} cameras at {} radii, {w}x{h}, {} interleaved rounds, 1 thread; meshlets of at most {} vertices and {} triangles, cone weight {}, tree t/r {}, vertices {}\n",
+        args.cameras,
+        args.distance,
+        args.rounds,
+        args.max_vertices,
+        args.max_triangles,
+        args.cone_weight,
+        args.t_over_r,
+        if args.copies { "copied per cluster" } else { "shared (a vertex list)" }
     );
     for r in reports {
         s += &format!(
-            "\n### {}: {} triangles, {} -> {} vertices, {} clusters, {} inner nodes, {} B of culling data, measured t/r {:.3}\n\n",
-            r.model, r.triangles, r.vertices[0], r.vertices[1], r.clusters[0], r.clusters[1], r.data_bytes, r.t_over_r
+            "\n### {}: {} triangles, {} -> {} vertices ({} list entries), {} clusters, {} inner nodes, {} B of culling data, measured t/r {:.3}\n\n",
+            r.model,
+            r.triangles,
+            r.vertices[0],
+            r.vertices[1],
+            r.vertices[2],
+            r.clusters[0],
+            r.clusters[1],
+            r.data_bytes,
+            r.t_over_r
         );
         s += "| method | triangles to transform | removed before transform | vertices transformed | set up | geometry ms (median, range) | frame ms (median, range) | frames differing |\n";
         s += "|---|---:|---:|---:|---:|---:|---:|---:|\n";
