@@ -245,6 +245,7 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spi
             colors: ObjectColors::PerVertex(colors),
             bounds,
             mvp: Mat4::IDENTITY,
+            clusters: None,
         }],
         clip_tris: Vec::new(),
     };
@@ -373,6 +374,7 @@ pub fn quad_scene() -> Scene {
             colors: ObjectColors::PerTriangle(vec![color; 2]),
             bounds,
             mvp: Mat4::IDENTITY,
+            clusters: None,
         }],
         clip_tris: Vec::new(),
     }

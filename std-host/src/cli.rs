@@ -87,6 +87,33 @@ Progress: runs that take over a few seconds report progress on stderr, on one
 updating line on a terminal and as plain lines otherwise (every
 MICRORASTER_PROGRESS_MS milliseconds, default 2000). The JSON on stdout is unchanged.";
 
+/// `--cull-clusters`: the cluster test.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClusterCullArg {
+    /// Culling volumes at the leaves.
+    Volumes,
+    /// Culling volumes, the tree top-down.
+    VolumesTree,
+    /// Normal cones at the leaves.
+    Cones,
+    /// Normal cones, the tree top-down.
+    ConesTree,
+}
+
+impl ClusterCullArg {
+    /// As the core's setting.
+    pub fn cull(self) -> microraster::ClusterCull {
+        use microraster::ClusterTest::{Cones, Volumes};
+        let (test, hierarchy) = match self {
+            ClusterCullArg::Volumes => (Volumes, false),
+            ClusterCullArg::VolumesTree => (Volumes, true),
+            ClusterCullArg::Cones => (Cones, false),
+            ClusterCullArg::ConesTree => (Cones, true),
+        };
+        microraster::ClusterCull { test, hierarchy }
+    }
+}
+
 /// Which triangles face away and are skipped.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CullArg {
@@ -189,6 +216,12 @@ pub struct RenderArgs {
     /// Face culling.
     #[arg(long, value_enum, default_value_t = CullArg::Back)]
     pub cull: CullArg,
+
+    /// Cull back-facing clusters before transform (meshoptimizer meshlets
+    /// of 16 triangles; see docs/culling.md): culling volumes or normal
+    /// cones, at the leaves or down the tree.
+    #[arg(long, value_enum, value_name = "TEST")]
+    pub cull_clusters: Option<ClusterCullArg>,
 
     /// Depth buffer format.
     #[arg(long, value_enum, default_value_t = DepthArg::U32)]
@@ -403,6 +436,12 @@ pub struct BenchArgs {
     /// Face culling.
     #[arg(long, value_enum, default_value_t = CullArg::Back)]
     pub cull: CullArg,
+
+    /// Cull back-facing clusters before transform (meshoptimizer meshlets
+    /// of 16 triangles; see docs/culling.md): culling volumes or normal
+    /// cones, at the leaves or down the tree.
+    #[arg(long, value_enum, value_name = "TEST")]
+    pub cull_clusters: Option<ClusterCullArg>,
 
     /// Depth buffer format [default: u16 for sphere, else u32].
     #[arg(long, value_enum)]

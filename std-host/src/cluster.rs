@@ -360,3 +360,38 @@ fn tree(mesh: &ClusteredMesh, t_over_r: f64) -> Vec<ClusterNode> {
     }
     out
 }
+
+/// Rebuilds every object of `scene` with `opts` clusters tested by `cull`
+/// (`render`/`bench --cull-clusters`): positions, triangles and colours
+/// in cluster order, each object then submitted whole through
+/// `Submit::submit_clusters`. Triangle ids follow the new order.
+pub fn cluster_scene(
+    scene: &mut crate::scene::Scene,
+    cull: microraster::ClusterCull,
+    opts: &ClusterOptions,
+) -> Result<(), String> {
+    use crate::scene::{ObjectClusters, ObjectColors};
+    for o in &mut scene.objects {
+        let c = build(&o.positions, &o.indices, opts)?;
+        o.colors = match &o.colors {
+            ObjectColors::PerTriangle(v) => ObjectColors::PerTriangle(
+                c.source_triangle.iter().map(|&t| v[t as usize]).collect(),
+            ),
+            ObjectColors::PerVertex(v) => ObjectColors::PerVertex(
+                c.source_vertex
+                    .iter()
+                    .map(|&k| v.get(k as usize).copied().unwrap_or_default())
+                    .collect(),
+            ),
+        };
+        o.clusters = Some(std::sync::Arc::new(ObjectClusters {
+            clusters: c.clusters,
+            nodes: c.nodes,
+            vertex_list: c.vertex_list,
+            cull,
+        }));
+        o.positions = c.positions;
+        o.indices = c.indices;
+    }
+    Ok(())
+}

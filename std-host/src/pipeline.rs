@@ -67,25 +67,29 @@ pub fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
     let per = total.div_ceil(parts.max(1)).max(1);
     let mut chunks: Vec<Vec<Piece>> = vec![Vec::new()];
     let mut room = per;
-    let mut push = |len: usize, make: &dyn Fn(Range<usize>) -> Piece| {
+    // `whole`: one piece however long (a clustered object is submitted
+    // whole: its clusters cover all its triangles).
+    let mut push = |len: usize, whole: bool, make: &dyn Fn(Range<usize>) -> Piece| {
         let mut start = 0;
         while start < len {
             if room == 0 {
                 chunks.push(Vec::new());
                 room = per;
             }
-            let take = room.min(len - start);
+            let take = if whole { len } else { room.min(len - start) };
             if let Some(c) = chunks.last_mut() {
                 c.push(make(start..start + take));
             }
             start += take;
-            room -= take;
+            room = room.saturating_sub(take);
         }
     };
     for (i, o) in scene.objects.iter().enumerate() {
-        push(o.indices.len(), &|r| Piece::Object(i, r));
+        push(o.indices.len(), o.clusters.is_some(), &|r| {
+            Piece::Object(i, r)
+        });
     }
-    push(scene.clip_tris.len(), &|r| Piece::ClipTris(r));
+    push(scene.clip_tris.len(), false, &|r| Piece::ClipTris(r));
     chunks
 }
 
@@ -116,6 +120,12 @@ pub fn fill<const S: u32>(
                     mesh.attributes = MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
                 }
                 let id = first_ids[*i].wrapping_add(r.start as u32);
+                if let Some(c) = &o.clusters {
+                    // Its own scratch cache: the vertex stage skipped it.
+                    let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
+                    frame.submit_clusters(&o.mesh(), &o.mvp, &c.set(), c.cull, id, &mut cache)?;
+                    continue;
+                }
                 match caches.get(*i).copied().flatten() {
                     Some(cache) => frame.submit_processed_mesh(&mesh, id, cache)?,
                     None => frame.submit_mesh(&mesh, &o.mvp, id)?,
@@ -368,7 +378,8 @@ fn vertex_stage<'c, const S: u32>(
     }
     let mut out = Vec::with_capacity(scene.objects.len());
     for (o, cache) in scene.objects.iter().zip(caches.iter_mut()) {
-        if o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
+        // Clustered objects process their vertices as their clusters pass.
+        if o.clusters.is_some() || o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
             out.push(None);
             continue;
         }

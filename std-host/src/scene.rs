@@ -31,6 +31,33 @@ pub struct Object {
     pub bounds: Option<BoundingSphere>,
     /// Object to clip space.
     pub mvp: Mat4,
+    /// Cluster culling: the object's triangles are then in cluster order
+    /// (see [`crate::cluster::cluster_scene`]).
+    pub clusters: Option<std::sync::Arc<ObjectClusters>>,
+}
+
+/// The clusters of an [`Object`] and how they are tested.
+#[derive(Clone, Debug)]
+pub struct ObjectClusters {
+    /// Triangle runs.
+    pub clusters: Vec<microraster::Cluster>,
+    /// The tree.
+    pub nodes: Vec<microraster::ClusterNode>,
+    /// The vertex list.
+    pub vertex_list: Vec<u32>,
+    /// The test.
+    pub cull: microraster::ClusterCull,
+}
+
+impl ObjectClusters {
+    /// The set the core reads.
+    pub fn set(&self) -> microraster::ClusterSet<'_> {
+        microraster::ClusterSet {
+            clusters: &self.clusters,
+            nodes: &self.nodes,
+            vertices: &self.vertex_list,
+        }
+    }
 }
 
 /// The colours of an [`Object`].
@@ -185,6 +212,7 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
             colors: colors.clone(),
             bounds: mesh.bounds,
             mvp: view_proj * cubes::model_matrix(ops),
+            clusters: None,
         })
         .collect();
     Ok(Scene {
@@ -230,6 +258,7 @@ pub fn mesh_scene(
             colors: ObjectColors::PerTriangle(colors),
             bounds,
             mvp: proj * view,
+            clusters: None,
         }],
         clip_tris: Vec::new(),
     })

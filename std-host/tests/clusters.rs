@@ -165,3 +165,41 @@ fn every_method_culls_a_share_of_each_mesh_from_64_cameras() {
         }
     }
 }
+
+/// `render --cull-clusters`'s path: a scene rebuilt in cluster order and
+/// drawn by the threaded pipeline draws the image of the plain scene (the
+/// convex sphere has no two front faces over one pixel, so the new
+/// triangle order cannot show), and its counters name the clusters.
+#[test]
+fn a_clustered_scene_renders_the_same_image_on_threads() {
+    use microraster_host::render::{render, DepthKind, RenderOptions};
+    use microraster_host::scene::View;
+    let plain = microraster_host::bench_scenes::builtin("sphere", &View::new(200, 150))
+        .unwrap()
+        .scene;
+    let mut clustered = plain.clone();
+    let cull = ClusterCull {
+        test: ClusterTest::Volumes,
+        hierarchy: true,
+    };
+    cluster::cluster_scene(&mut clustered, cull, &ClusterOptions::default()).unwrap();
+    let ro = |threads| RenderOptions {
+        width: 200,
+        height: 150,
+        cull: microraster::CullMode::Back,
+        depth: DepthKind::U16,
+        subpixel: 8,
+        threads,
+        strip_rows: 16,
+        ids: false,
+    };
+    let want = render(&plain, &ro(1)).unwrap();
+    for threads in [1, 2, 3] {
+        let got = render(&clustered, &ro(threads)).unwrap();
+        assert!(got.rgb == want.rgb, "{threads} threads");
+        assert_eq!(got.depth, want.depth);
+        let s = got.stats;
+        assert_eq!(s.submitted, want.stats.submitted);
+        assert!(s.culled_cluster + s.culled_hierarchy > 0, "{s:?}");
+    }
+}

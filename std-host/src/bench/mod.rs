@@ -181,6 +181,10 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
         }
         None => bench_scenes::builtin(&args.scene, &view)?,
     };
+    if let Some(c) = args.cull_clusters {
+        let opts = crate::cluster::ClusterOptions::default();
+        crate::cluster::cluster_scene(&mut bs.scene, c.cull(), &opts)?;
+    }
     if bs.spin.is_some() || s.spin != 0.0 {
         let mut spin = bs
             .spin
