@@ -202,12 +202,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         cache: &mut [ProcessedVertex],
     ) -> Result<(), Error> {
         let n = check_mesh_len(mesh.indices.len())?;
-        let Some(cache) = cache.get_mut(..mesh.positions.len()) else {
-            return Err(Error::VertexCacheSize {
-                expected: mesh.positions.len(),
-                actual: cache.len(),
-            });
-        };
+        let cache = sized_cache(cache, mesh.positions.len())?;
         if culled_object(&mut self.parts(), mesh, mvp, n) {
             return Ok(());
         }
@@ -221,9 +216,11 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     /// [`Stats::culled_hierarchy`], skipped by an inner node of the tree
     /// when `cull.hierarchy` is set) without transforming any of its
     /// vertices; the others are processed into `cache` (at their vertex
-    /// ranges) and submitted as by `submit_mesh_cached`. The frame is the
-    /// one `submit_mesh_cached` draws, for set data that bounds its
-    /// triangles; data that does not fit the mesh is refused with
+    /// ranges) and submitted as by `submit_mesh_cached`. For set data that
+    /// bounds its triangles the frame is the one `submit_mesh_cached`
+    /// draws (skipped triangles are at least [`MARGIN`](crate::cull::MARGIN)
+    /// past edge-on; see [`crate::cull`] for the sub-subpixel caveat and the
+    /// property tests); data that does not fit the mesh is refused with
     /// [`Error::InvalidClusters`] before anything is done. Nothing is
     /// culled by clusters under [`CullMode::None`](crate::CullMode).
     fn submit_clusters<A: Attributes<N>>(
@@ -236,12 +233,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         cache: &mut [ProcessedVertex],
     ) -> Result<(), Error> {
         let n = check_mesh_len(mesh.indices.len())?;
-        let Some(cache) = cache.get_mut(..mesh.positions.len()) else {
-            return Err(Error::VertexCacheSize {
-                expected: mesh.positions.len(),
-                actual: cache.len(),
-            });
-        };
+        let cache = sized_cache(cache, mesh.positions.len())?;
         set.validate(mesh.indices.len(), mesh.positions.len())?;
         if culled_object(&mut self.parts(), mesh, mvp, n) {
             return Ok(());
@@ -368,6 +360,16 @@ macro_rules! impl_submit {
     };
 }
 pub(crate) use impl_submit;
+
+/// The first `n` entries of a vertex cache, or the error for a short one.
+#[inline]
+fn sized_cache(cache: &mut [ProcessedVertex], n: usize) -> Result<&mut [ProcessedVertex], Error> {
+    let actual = cache.len();
+    cache.get_mut(..n).ok_or(Error::VertexCacheSize {
+        expected: n,
+        actual,
+    })
+}
 
 /// Triangle counts per submission fit `u32` (ids are 32-bit).
 fn check_mesh_len(n: usize) -> Result<u64, Error> {
