@@ -23,15 +23,15 @@
 //!   within the cone's cutoff of its axis.
 //!
 //! The rasterizer culls by the sign of the snapped area, in fixed point;
-//! these tests decide in `f32` on object-space geometry. So that a rounded
-//! or snapped triangle is never skipped when the per-triangle path would
-//! draw it, both tests demand a margin: every skipped triangle is seen at
-//! least [`MARGIN`] (as the sine of the angle) past edge-on, far beyond
-//! the `f32` rounding of the tests (below `2^-20` relatively), and a node
-//! with a zero-area triangle (no normal) is never culled. A triangle that
-//! far past edge-on flips its snapped winding only when it is a fraction
-//! of a subpixel in size; the property tests check frames byte-identical
-//! to per-triangle culling over random cameras.
+//! these tests decide in `f32` on object-space geometry. So both tests
+//! demand a margin: every skipped triangle is seen at least [`MARGIN`] (as
+//! the sine of the angle) past edge-on, far beyond the `f32` rounding of
+//! the tests (below `2^-20` relatively), and a node with a zero-area
+//! triangle (no normal) is never culled. A triangle that far past edge-on
+//! flips its snapped winding only when it is far below a pixel in size;
+//! then the per-triangle path sets it up and, rarely, it shows (one pixel
+//! in a case the property tests found; docs/culling.md). Frames are
+//! byte-identical whenever the same pieces are set up.
 //!
 //! Bad data (ranges out of order or out of bounds, a tree whose subtrees
 //! do not tile the clusters) is refused by [`ClusterSet::validate`] with
