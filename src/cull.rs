@@ -102,8 +102,15 @@ impl CullVolume {
         radius: 0.0,
     };
 
-    /// How the triangles face the eye `e` (see [`Eye`]).
+    /// How the triangles face the eye `e` (see [`Eye`]), geometrically
+    /// (no size guard).
     pub fn facing(&self, e: &Eye) -> Facing {
+        self.facing_bound(e).0
+    }
+
+    /// [`CullVolume::facing`], with a lower bound on `|facing value|`
+    /// for a back-facing node.
+    fn facing_bound(&self, e: &Eye) -> (Facing, f32) {
         let vals = [
             self.origin[0],
             self.origin[1],
@@ -119,7 +126,7 @@ impl CullVolume {
             self.radius,
         ];
         if !(self.d_min <= self.d_max) || !vals.iter().all(|v| v.is_finite()) {
-            return Facing::Mixed;
+            return (Facing::Mixed, 0.0);
         }
         let k = e.k;
         let mut t = [0.0f32; 3];
@@ -145,11 +152,11 @@ impl CullVolume {
         lower -= dk_lo;
         let delta = MARGIN * (t1 + k.abs() * self.radius) + ROUNDING * (e.xyz1 + k.abs() * c1);
         if upper < -delta {
-            Facing::Back
+            (Facing::Back, -upper)
         } else if lower > delta {
-            Facing::Front
+            (Facing::Front, 0.0)
         } else {
-            Facing::Mixed
+            (Facing::Mixed, 0.0)
         }
     }
 }
@@ -181,13 +188,18 @@ impl NormalCone {
     /// 0`; that is the rasterizer's back face only for an eye in front
     /// of the projection (`k > 0`, see [`Eye`]), so other eyes never cull.
     pub fn back_facing(&self, e: &Eye) -> bool {
+        self.back_bound(e).is_some()
+    }
+
+    /// For a back-facing cone, a lower bound on `|facing value|`: `k` times
+    /// a lower bound on `n . (apex - e)`, which bounds `-n . (e - p)` as
+    /// the apex lies behind every triangle's plane.
+    fn back_bound(&self, e: &Eye) -> Option<f32> {
         let ok = self.apex.iter().chain(&self.axis).all(|v| v.is_finite());
         if !ok || !(self.cutoff < 1.0) || !(e.k > 0.0) {
-            return false;
+            return None;
         }
-        let Some(p) = e.point else {
-            return false;
-        };
+        let p = e.point?;
         let mut g = [0.0f32; 3];
         let (mut d, mut gg, mut p1) = (0.0f32, 0.0f32, 0.0f32);
         for a in 0..3 {
@@ -199,7 +211,21 @@ impl NormalCone {
         // d >= (cutoff + MARGIN) |g|, with d shrunk by the rounding of e.
         let d = d - ROUNDING * p1;
         let c = self.cutoff.max(0.0) + MARGIN;
-        d > 0.0 && d * d >= c * c * gg
+        if !(d > 0.0 && d * d >= c * c * gg) {
+            return None;
+        }
+        // Every normal is within theta (sin theta = cutoff) of the axis,
+        // the axis within acos(beta) of g: n . g >= |g| cos(theta +
+        // acos(beta)) = |g| (cos(theta) beta - cutoff sqrt(1 - beta^2)),
+        // positive since beta >= cutoff + MARGIN.
+        let len = crate::math::fx::sqrt(gg);
+        let beta = (d / len).min(1.0);
+        let cut = self.cutoff.max(0.0);
+        let cos_t = crate::math::fx::sqrt((1.0 - cut * cut).max(0.0));
+        let lb = cos_t * beta - cut * crate::math::fx::sqrt((1.0 - beta * beta).max(0.0));
+        // Shrunk for the float functions (micromath's sqrt is approximate).
+        let lb = lb - 0.05 * MARGIN;
+        (lb > 0.0).then_some(e.k * lb * len * (1.0 - 1.0 / 64.0))
     }
 }
 
@@ -281,6 +307,34 @@ fn unit_triangles<'a>(
         }
         Some((p, n.map(|c| c / len)))
     })
+}
+
+/// The size guard's data of the triangles `indices` ([`ClusterNode::size`]):
+/// the least `2A / (|p1 - p0| + |p2 - p0|)` and the least `2A`, in `f64`,
+/// rounded down; zeros for no triangles or one that fails (as for
+/// [`CullVolume::from_triangles`]).
+pub fn triangle_sizes(positions: &[Vec3], indices: &[[u32; 3]]) -> [f32; 2] {
+    let (mut q, mut a) = (f64::INFINITY, f64::INFINITY);
+    for t in unit_triangles(positions, indices) {
+        let Some((p, n)) = t else {
+            return [0.0; 2];
+        };
+        let (u, v) = (sub(p[1], p[0]), sub(p[2], p[0]));
+        // |u x v| again, from the unit normal: n . (u x v).
+        let cross = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let area2 = dot(n, cross);
+        let edges = sqrt64(dot(u, u)) + sqrt64(dot(v, v));
+        q = q.min(area2 / edges);
+        a = a.min(area2);
+    }
+    if !(q.is_finite() && a.is_finite() && q > 0.0 && a > 0.0) {
+        return [0.0; 2];
+    }
+    [down(q * (1.0 - E30)), down(a * (1.0 - E30))]
 }
 
 impl CullVolume {
@@ -394,6 +448,11 @@ pub struct ClusterNode {
     pub volume: CullVolume,
     /// The normal cone of all its triangles.
     pub cone: NormalCone,
+    /// For the size guard ([`Eye::for_frame`]): the least ratio of a
+    /// triangle's doubled area to the sum of its edges from its first
+    /// vertex, and the least doubled area (object units; see
+    /// [`triangle_sizes`]). Zeros never pass the guard.
+    pub size: [f32; 2],
 }
 
 /// A mesh's clusters and the tree over them, as the offline step wrote
@@ -540,6 +599,26 @@ pub struct Eye {
     xyz1: f32,
     /// `E_xyz / E_w`, the eye as a point, when finite.
     pub point: Option<[f32; 3]>,
+    /// The scale of `E`: the cofactors are `big` times the stored values.
+    big: f32,
+    /// The frame, for the size guard ([`Eye::for_frame`]); `None` for a
+    /// geometric eye ([`Eye::from_mvp`], [`Eye::at`]).
+    screen: Option<Screen>,
+}
+
+/// What the size guard needs of a frame: the clip planes and the rows
+/// `x`, `y`, `w` of the matrix as linear forms on the object-space point
+/// `(p, 1)`, each with `|l_xyz|`, and the viewport.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Screen {
+    /// Near, far and the four guard-band planes.
+    planes: [([f32; 4], f32); 6],
+    /// Rows `x`, `y`, `w`.
+    rows: [([f32; 4], f32); 3],
+    /// `W / 2`, `H / 2`.
+    half: [f32; 2],
+    /// Half a subpixel, pixels.
+    snap: f32,
 }
 
 impl Eye {
@@ -587,7 +666,113 @@ impl Eye {
             k: sign * e[3],
             xyz1: xyz.iter().map(|v| v.abs()).sum(),
             point,
+            big: big as f32,
+            screen: None,
         })
+    }
+
+    /// The eye [`Submit::submit_clusters`](crate::Submit::submit_clusters)
+    /// uses for a frame of `config` at `S` subpixel bits: that of
+    /// [`Eye::from_mvp`] with the size guard, which culls a node only
+    /// where every triangle's projected area exceeds what snapping (half a
+    /// subpixel) and rounding can change, so no skipped triangle can snap
+    /// to the other winding: then the frame is byte-identical to
+    /// per-triangle culling. `None` where that cannot be set up.
+    pub fn for_frame<const S: u32>(mvp: &Mat4, config: &crate::Config) -> Option<Eye> {
+        let mut e = Eye::from_mvp(mvp, config.cull, config.front_face)?;
+        let (gx, gy) = crate::fixed::guard_band_ndc::<S>(config.width, config.height);
+        let c = &mvp.cols;
+        let row = |i: usize| [c[0][i], c[1][i], c[2][i], c[3][i]];
+        let (rx, ry, rz, rw) = (row(0), row(1), row(2), row(3));
+        let comb = |a: [f32; 4], sa: f32, b: [f32; 4], sb: f32| -> [f32; 4] {
+            core::array::from_fn(|j| sa * a[j] + sb * b[j])
+        };
+        let norm = |l: [f32; 4]| crate::math::fx::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+        let with_norm = |l: [f32; 4]| (l, norm(l));
+        let planes = [
+            with_norm(comb(rw, 1.0, rz, 1.0)),
+            with_norm(comb(rw, 1.0, rz, -1.0)),
+            with_norm(comb(rw, gx, rx, -1.0)),
+            with_norm(comb(rw, gx, rx, 1.0)),
+            with_norm(comb(rw, gy, ry, -1.0)),
+            with_norm(comb(rw, gy, ry, 1.0)),
+        ];
+        let screen = Screen {
+            planes,
+            rows: [with_norm(rx), with_norm(ry), with_norm(rw)],
+            half: [config.width as f32 * 0.5, config.height as f32 * 0.5],
+            snap: 1.0 / (1u32 << (S + 1)) as f32,
+        };
+        let ok = screen
+            .planes
+            .iter()
+            .chain(&screen.rows)
+            .all(|(l, n)| l.iter().all(|v| v.is_finite()) && n.is_finite())
+            && e.big.is_finite();
+        if !ok {
+            return None;
+        }
+        e.screen = Some(screen);
+        Some(e)
+    }
+}
+
+impl Screen {
+    /// Whether every triangle of a node (within `radius` of `origin`;
+    /// least doubled area `a_min`, least ratio `q` of doubled area to the
+    /// sum of two edges, object units) whose facing values are at least
+    /// `phi` (for unit normals and `E` scaled by `big`) keeps its winding
+    /// when snapped. The node must lie inside near, far and the guard band
+    /// (so no triangle is clipped) and in front of the eye (`w_min > 0`).
+    /// With `X = phi big (W/2)(H/2) / w_max^3` (pixel area per object
+    /// area, at least, since `2 A_ndc = |n . (E_xyz - E_w p)| / (w0 w1
+    /// w2)`), `M` the most pixels per object length (from `|d(x/w)/dp| <=
+    /// (|r_x| + |x/w| |r_w|) / w` with `|x/w|` bounded over the node) and
+    /// `rho` half a subpixel plus the `f32` rounding of transform and
+    /// projection, it demands `X q > 4 sqrt 2 rho M` and `X a_min > 16
+    /// rho^2`: then the snapped doubled area `2A'` of every triangle keeps
+    /// its sign, as `|2A' - 2A| <= 2 rho (|e1|_1 + |e2|_1) + 8 rho^2 <=
+    /// 2 sqrt 2 rho M (|e1| + |e2|) + 8 rho^2 < |2A|`.
+    fn keeps_winding(
+        &self,
+        origin: [f32; 3],
+        radius: f32,
+        size: [f32; 2],
+        phi: f32,
+        big: f32,
+    ) -> bool {
+        let [q, a_min] = size;
+        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
+        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
+        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+        // A form's range over the node: centre value +- spread.
+        let spread = |l: &[f32; 4], n: f32| n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1;
+        for (l, n) in &self.planes {
+            if !(at(l) > spread(l, *n)) {
+                return false;
+            }
+        }
+        let [(rx, nx), (ry, ny), (rw, nw)] = &self.rows;
+        let (wc, wr) = (at(rw), spread(rw, *nw));
+        let (w_min, w_max) = (wc - wr, wc + wr);
+        if !(w_min > 0.0) {
+            return false;
+        }
+        // |x/w| and |y/w| over the node.
+        let gx = (at(rx).abs() + spread(rx, *nx)) / w_min;
+        let gy = (at(ry).abs() + spread(ry, *ny)) / w_min;
+        let [hw, hh] = self.half;
+        let (mx, my) = (hw * (nx + gx * nw), hh * (ny + gy * nw));
+        let m = crate::math::fx::sqrt(mx * mx + my * my) * (1.0 + ROUNDING) / w_min;
+        let x = phi * big * hw * hh / (w_max * w_max * w_max);
+        // Rounding: the transform (3 roundings a row, 2^-22 relative to
+        // |row|_1 |(p, 1)|_inf, through the division by w) and NDC to
+        // pixels (a few ulps of the pixel coordinate).
+        let transform = (hw * (l1(rx) + gx * l1(rw)) + hh * (l1(ry) + gy * l1(rw))) * c1 / w_min;
+        let pixels = hw * (1.0 + gx) + hh * (1.0 + gy);
+        let rho = self.snap + (transform + pixels) / 1_048_576.0;
+        x * q > 4.0 * core::f32::consts::SQRT_2 * rho * m * (1.0 + MARGIN)
+            && x * a_min > 16.0 * rho * rho
     }
 }
 
@@ -607,6 +792,8 @@ impl Eye {
             k: 1.0,
             xyz1: p.iter().map(|v| v.abs()).sum(),
             point: Some(p),
+            big: 1.0,
+            screen: None,
         })
     }
 }
@@ -614,11 +801,29 @@ impl Eye {
 impl ClusterNode {
     /// How the node's triangles face `e` under `test`: cones tell only
     /// back-facing from not.
+    /// With an eye for a frame ([`Eye::for_frame`]) a back-facing node
+    /// is reported only where the size guard holds as well.
     pub fn facing(&self, e: &Eye, test: ClusterTest) -> Facing {
-        match test {
-            ClusterTest::Volumes => self.volume.facing(e),
-            ClusterTest::Cones if self.cone.back_facing(e) => Facing::Back,
-            ClusterTest::Cones => Facing::Mixed,
+        let (f, phi) = match test {
+            ClusterTest::Volumes => self.volume.facing_bound(e),
+            ClusterTest::Cones => match self.cone.back_bound(e) {
+                Some(phi) => (Facing::Back, phi),
+                None => (Facing::Mixed, 0.0),
+            },
+        };
+        match (f, &e.screen) {
+            (Facing::Back, Some(sc)) => {
+                let v = &self.volume;
+                // The volume's sphere bounds the node (for cones too).
+                let sized = v.d_min <= v.d_max
+                    && sc.keeps_winding(v.origin, v.radius, self.size, phi, e.big);
+                if sized {
+                    Facing::Back
+                } else {
+                    Facing::Mixed
+                }
+            }
+            (f, _) => f,
         }
     }
 }
@@ -769,6 +974,7 @@ mod tests {
             skip,
             volume: CullVolume::NEVER,
             cone: NormalCone::NEVER,
+            size: [0.0; 2],
         }
     }
 

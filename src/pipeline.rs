@@ -238,8 +238,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         if culled_object(&mut self.parts(), mesh, mvp, n) {
             return Ok(());
         }
-        let c = self.stage().config;
-        let eye = Eye::from_mvp(mvp, c.cull, c.front_face);
+        let eye = Eye::for_frame::<S>(mvp, &self.stage().config);
         let list = set.vertices;
         let drawn = |f: &mut dyn FnMut(&Cluster)| {
             traverse(set, eye.as_ref(), cull, |v| {
@@ -725,15 +724,15 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
         self.inner.max_pieces()
     }
 
-    /// The plain path's bound, over the clusters drawn: their triangle
-    /// count where no cache entry needs clipping (one sequential pass),
-    /// else one piece or seven per triangle.
+    /// The mesh's triangle count where no cache entry needs clipping (one
+    /// sequential pass), else one piece or seven per triangle of the
+    /// clusters drawn.
     fn bound(&self, _: &Stage) -> usize {
         let cache = self.inner.cache;
         if !cache.iter().any(|v| v.code & outcode::CLIP != 0) {
-            let mut n = 0usize;
-            self.visit(|tris, _| n = n.saturating_add(tris.len()), |_, _| {});
-            return n;
+            // At most one piece a triangle, drawn or not: no walk of the
+            // tree (its tests are the costly part).
+            return self.inner.mesh.indices.len();
         }
         let code = |k: u32| cache.get(k as usize).map_or(0, |v| v.code);
         let mut n = 0usize;

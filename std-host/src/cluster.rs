@@ -252,6 +252,7 @@ fn node(mesh: &ClusteredMesh, a: usize, b: usize) -> ClusterNode {
         skip: 0,
         volume,
         cone: NormalCone::from_triangles(&mesh.positions, tris),
+        size: microraster::cull::triangle_sizes(&mesh.positions, tris),
     }
 }
 

@@ -198,15 +198,11 @@ fn submit(
 }
 
 /// Vertices a frame transforms.
-fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
+fn vertices_transformed(case: &Case<'_>, mvp: &Mat4, config: &Config) -> usize {
     let Some((c, cull)) = case.set else {
         return case.mesh.positions.len();
     };
-    let eye = Eye::from_mvp(
-        mvp,
-        microraster::CullMode::Back,
-        microraster::FrontFace::Ccw,
-    );
+    let eye = Eye::for_frame::<8>(mvp, config);
     let mut seen = vec![false; c.positions.len()];
     let mut n = 0;
     c.set().visit(eye.as_ref(), cull, |v| {
@@ -302,7 +298,7 @@ fn measure(
             let skipped = s.culled_cluster + s.culled_hierarchy;
             row.triangles_to_transform += (s.submitted - skipped) as f64 / cams;
             row.removed_before_transform += skipped as f64 / s.submitted.max(1) as f64 / cams;
-            row.vertices_transformed += vertices_transformed(case, mvp) as f64 / cams;
+            row.vertices_transformed += vertices_transformed(case, mvp, &config) as f64 / cams;
             row.triangles_set_up += s.stored as f64 / cams;
             if row.method != Method::Source {
                 let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
