@@ -28,10 +28,11 @@
 //! the sine of the angle) past edge-on, far beyond the `f32` rounding of
 //! the tests (below `2^-20` relatively), and a node with a zero-area
 //! triangle (no normal) is never culled. A triangle that far past edge-on
-//! flips its snapped winding only when it is far below a pixel in size;
-//! then the per-triangle path sets it up and, rarely, it shows (one pixel
-//! in a case the property tests found; docs/culling.md). Frames are
-//! byte-identical whenever the same pieces are set up.
+//! can still flip its snapped winding when it is far below a pixel in
+//! size, so for a frame ([`Eye::for_frame`]) a size guard culls a node
+//! only where no triangle of it can: every skipped triangle is one the
+//! per-triangle path culls by winding, the same pieces are set up and the
+//! frame is byte-identical (docs/culling.md has the bound and the tests).
 //!
 //! Bad data (ranges out of order or out of bounds, a tree whose subtrees
 //! do not tile the clusters) is refused by [`ClusterSet::validate`] with

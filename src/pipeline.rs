@@ -218,9 +218,9 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     /// vertices; the others are processed into `cache` (at their vertex
     /// ranges) and submitted as by `submit_mesh_cached`. For set data that
     /// bounds its triangles the frame is the one `submit_mesh_cached`
-    /// draws (skipped triangles are at least [`MARGIN`](crate::cull::MARGIN)
-    /// past edge-on; see [`crate::cull`] for the sub-subpixel caveat and the
-    /// property tests); data that does not fit the mesh is refused with
+    /// draws: the margin and size guard of [`Eye::for_frame`] skip only
+    /// triangles it culls by winding (see [`crate::cull`]); data that does
+    /// not fit the mesh is refused with
     /// [`Error::InvalidClusters`] before anything is done. Nothing is
     /// culled by clusters under [`CullMode::None`](crate::CullMode).
     fn submit_clusters<A: Attributes<N>>(
