@@ -259,29 +259,34 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
                 }
             });
         } else {
-            // The drawn clusters' vertices marked stale, then each
-            // processed once; no other entry is read (a triangle using
-            // one the list misses meets a stale or old entry: see
-            // `Cluster::vertices`).
-            let ids = |k: &Cluster| list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+            // The drawn clusters' vertices marked stale in one walk, then
+            // every stale entry processed, in runs, by one pass over the
+            // cache (no second walk of the tree). An entry found stale is
+            // one marked now or a non-finite vertex of an earlier frame
+            // (processing it again gives the same entry); no other entry
+            // is read (a triangle using one the list misses meets a stale
+            // or old entry: see `Cluster::vertices`).
             drawn(&mut |k| {
-                for &id in ids(k).unwrap_or(&[]) {
+                let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+                for &id in ids.unwrap_or(&[]) {
                     if let Some(out) = cache.get_mut(id as usize) {
                         *out = ProcessedVertex::STALE;
                     }
                 }
             });
-            drawn(&mut |k| {
-                for &id in ids(k).unwrap_or(&[]) {
-                    let id = id as usize;
-                    if let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id)) {
-                        if out.code & NONFINITE != 0 {
-                            let (p, out) = (core::slice::from_ref(p), core::slice::from_mut(out));
-                            self.process_vertices(mvp, p, out);
-                        }
-                    }
+            let stale = |v: &ProcessedVertex| v.code & NONFINITE != 0;
+            let mut i = 0;
+            while let Some(start) = cache.get(i..).and_then(|c| c.iter().position(stale)) {
+                let a = i + start;
+                let run = cache
+                    .get(a..)
+                    .map_or(0, |c| c.iter().take_while(|v| stale(v)).count());
+                let b = a + run;
+                if let (Some(p), Some(out)) = (mesh.positions.get(a..b), cache.get_mut(a..b)) {
+                    self.process_vertices(mvp, p, out);
                 }
-            });
+                i = b;
+            }
         }
         let job = ClusterJob {
             inner: ProcessedJob {
