@@ -46,11 +46,20 @@ pub struct Config {
     pub depth_func: DepthFunc,
     /// Whether passing fragments write their depth.
     pub depth_write: bool,
+    /// Detail culling, lossy (0, the default: off): an object whose
+    /// [`Mesh::bounds`](crate::Mesh::bounds), or a cluster-tree node whose
+    /// [`ClusterNode::sphere`](crate::ClusterNode::sphere), provably
+    /// projects to less than `detail` pixels across is dropped before any
+    /// of its vertices is transformed, and counted in
+    /// [`Stats::culled_detail`](crate::Stats::culled_detail) (see
+    /// [`Detail`](crate::Detail)). Small objects vanish, and small clusters
+    /// of a surface leave holes of about that size.
+    pub detail: u16,
 }
 
 impl Config {
     /// A `width x height` frame with back-face culling, CCW front faces,
-    /// depth test `Less` and depth writes on.
+    /// depth test `Less`, depth writes on and no detail culling.
     pub const fn new(width: u32, height: u32) -> Self {
         Config {
             width,
@@ -59,6 +68,7 @@ impl Config {
             front_face: FrontFace::Ccw,
             depth_func: DepthFunc::Less,
             depth_write: true,
+            detail: 0,
         }
     }
 }

@@ -46,6 +46,7 @@
 
 use crate::config::{CullMode, Error, FrontFace};
 use crate::math::{Mat4, Vec3};
+use crate::mesh::BoundingSphere;
 
 /// The least sine of the angle past edge-on at which a skipped triangle
 /// is seen (`2^-8`, about 0.22°).
@@ -338,6 +339,51 @@ pub fn triangle_sizes(positions: &[Vec3], indices: &[[u32; 3]]) -> [f32; 2] {
     [down(q * (1.0 - E30)), down(a * (1.0 - E30))]
 }
 
+/// A sphere around every vertex of the triangles `indices`
+/// ([`ClusterNode::sphere`]): about the centre of their box (rounded to
+/// `f32`), the radius computed in `f64` and rounded up;
+/// [`BoundingSphere::EVERYWHERE`] for no triangles, a bad index or a
+/// non-finite position.
+pub fn triangle_sphere(positions: &[Vec3], indices: &[[u32; 3]]) -> BoundingSphere {
+    let point = |k: u32| -> Option<[f64; 3]> {
+        let p = positions.get(k as usize)?;
+        let q = [p.x, p.y, p.z].map(f64::from);
+        q.iter().all(|v| v.is_finite()).then_some(q)
+    };
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &k in indices.iter().flatten() {
+        let Some(q) = point(k) else {
+            return BoundingSphere::EVERYWHERE;
+        };
+        for a in 0..3 {
+            lo[a] = lo[a].min(q[a]);
+            hi[a] = hi[a].max(q[a]);
+        }
+    }
+    if indices.is_empty() {
+        return BoundingSphere::EVERYWHERE;
+    }
+    let c = [0, 1, 2].map(|a| (0.5 * (lo[a] + hi[a])) as f32);
+    let cf = c.map(f64::from);
+    let r2 = indices
+        .iter()
+        .flatten()
+        .filter_map(|&k| point(k))
+        .map(|q| {
+            let d = sub(q, cf);
+            dot(d, d)
+        })
+        .fold(0.0f64, f64::max);
+    let radius = up(sqrt64(r2) * (1.0 + E40));
+    if !(c.iter().all(|v| v.is_finite()) && radius.is_finite()) {
+        return BoundingSphere::EVERYWHERE;
+    }
+    BoundingSphere {
+        center: Vec3::from_array(c),
+        radius,
+    }
+}
+
 impl CullVolume {
     /// The volume of the triangles `indices` (into `positions`) about the
     /// local origin `origin`, computed in `f64` and rounded outward;
@@ -454,6 +500,12 @@ pub struct ClusterNode {
     /// vertex, and the least doubled area (object units; see
     /// [`triangle_sizes`]). Zeros never pass the guard.
     pub size: [f32; 2],
+    /// A sphere around every vertex of its triangles, about the centre of
+    /// their box ([`triangle_sphere`]): the size guard and detail culling
+    /// bound the node's projection with it (the culling volume's own
+    /// radius is about its origin, which may be a corner of the box, up to
+    /// twice as far). [`BoundingSphere::EVERYWHERE`] passes neither.
+    pub sphere: BoundingSphere,
 }
 
 /// A mesh's clusters and the tree over them, as the offline step wrote
@@ -607,19 +659,40 @@ pub struct Eye {
     screen: Option<Screen>,
 }
 
-/// What the size guard needs of a frame: the clip planes and the rows
-/// `x`, `y`, `w` of the matrix as linear forms on the object-space point
-/// `(p, 1)`, each with `|l_xyz|`, and the viewport.
+/// The rows `x`, `y`, `w` of a model-view-projection matrix as linear
+/// forms on the object-space point `(p, 1)`, each with `|l_xyz|`, and
+/// half the viewport: how object space maps to pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Screen {
-    /// Near, far and the four guard-band planes.
-    planes: [([f32; 4], f32); 6],
+struct Projection {
     /// Rows `x`, `y`, `w`.
     rows: [([f32; 4], f32); 3],
     /// `W / 2`, `H / 2`.
     half: [f32; 2],
+}
+
+/// What the size guard needs of a frame: the projection, the clip planes
+/// as linear forms (with `|l_xyz|`) and the snapping step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Screen {
+    view: Projection,
+    /// Near, far and the four guard-band planes.
+    planes: [([f32; 4], f32); 6],
     /// Half a subpixel, pixels.
     snap: f32,
+}
+
+/// [`Projection::reach`]: over a ball, the least and greatest `w`, bounds
+/// on `|x/w|` and `|y/w|`, the most pixels per object length (`m`; `axis`
+/// for the pixel `x` and `y` alone), and `|origin|_1 + radius + 1` (for
+/// rounding bounds).
+struct Reach {
+    w_min: f32,
+    w_max: f32,
+    gx: f32,
+    gy: f32,
+    m: f32,
+    axis: [f32; 2],
+    c1: f32,
 }
 
 impl Eye {
@@ -681,36 +754,8 @@ impl Eye {
     /// per-triangle culling. `None` where that cannot be set up.
     pub fn for_frame<const S: u32>(mvp: &Mat4, config: &crate::Config) -> Option<Eye> {
         let mut e = Eye::from_mvp(mvp, config.cull, config.front_face)?;
-        let (gx, gy) = crate::fixed::guard_band_ndc::<S>(config.width, config.height);
-        let c = &mvp.cols;
-        let row = |i: usize| [c[0][i], c[1][i], c[2][i], c[3][i]];
-        let (rx, ry, rz, rw) = (row(0), row(1), row(2), row(3));
-        let comb = |a: [f32; 4], sa: f32, b: [f32; 4], sb: f32| -> [f32; 4] {
-            core::array::from_fn(|j| sa * a[j] + sb * b[j])
-        };
-        let norm = |l: [f32; 4]| crate::math::fx::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
-        let with_norm = |l: [f32; 4]| (l, norm(l));
-        let planes = [
-            with_norm(comb(rw, 1.0, rz, 1.0)),
-            with_norm(comb(rw, 1.0, rz, -1.0)),
-            with_norm(comb(rw, gx, rx, -1.0)),
-            with_norm(comb(rw, gx, rx, 1.0)),
-            with_norm(comb(rw, gy, ry, -1.0)),
-            with_norm(comb(rw, gy, ry, 1.0)),
-        ];
-        let screen = Screen {
-            planes,
-            rows: [with_norm(rx), with_norm(ry), with_norm(rw)],
-            half: [config.width as f32 * 0.5, config.height as f32 * 0.5],
-            snap: 1.0 / (1u32 << (S + 1)) as f32,
-        };
-        let ok = screen
-            .planes
-            .iter()
-            .chain(&screen.rows)
-            .all(|(l, n)| l.iter().all(|v| v.is_finite()) && n.is_finite())
-            && e.big.is_finite();
-        if !ok {
+        let screen = Screen::new::<S>(mvp, config)?;
+        if !e.big.is_finite() {
             return None;
         }
         e.screen = Some(screen);
@@ -718,7 +763,106 @@ impl Eye {
     }
 }
 
+/// A linear form with `|l_xyz|`.
+fn with_norm(l: [f32; 4]) -> ([f32; 4], f32) {
+    (
+        l,
+        crate::math::fx::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]),
+    )
+}
+
+/// Whether a form and its norm are finite.
+fn finite_form((l, n): &([f32; 4], f32)) -> bool {
+    l.iter().all(|v| v.is_finite()) && n.is_finite()
+}
+
+impl Projection {
+    /// The projection of a frame of `config` drawn with `mvp`; `None` for
+    /// a non-finite matrix.
+    fn new(mvp: &Mat4, config: &crate::Config) -> Option<Projection> {
+        let c = &mvp.cols;
+        let row = |i: usize| [c[0][i], c[1][i], c[2][i], c[3][i]];
+        let view = Projection {
+            rows: [row(0), row(1), row(3)].map(with_norm),
+            half: [config.width as f32 * 0.5, config.height as f32 * 0.5],
+        };
+        view.rows.iter().all(finite_form).then_some(view)
+    }
+
+    /// How the projection behaves over the ball of `radius` around
+    /// `origin` (object units), with the `f32` rounding of these bounds
+    /// allowed for; `None` unless the whole ball has `w > 0`.
+    fn reach(&self, origin: [f32; 3], radius: f32) -> Option<Reach> {
+        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
+        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
+        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+        // A form's range over the ball: centre value +- spread.
+        let spread = |l: &[f32; 4], n: f32| n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1;
+        let [(rx, nx), (ry, ny), (rw, nw)] = &self.rows;
+        let (wc, wr) = (at(rw), spread(rw, *nw));
+        let (w_min, w_max) = (wc - wr, wc + wr);
+        if !(w_min > 0.0) {
+            return None;
+        }
+        // |x/w| and |y/w| over the ball.
+        let gx = (at(rx).abs() + spread(rx, *nx)) / w_min;
+        let gy = (at(ry).abs() + spread(ry, *ny)) / w_min;
+        let [hw, hh] = self.half;
+        let (mx, my) = (hw * (nx + gx * nw), hh * (ny + gy * nw));
+        let m = crate::math::fx::sqrt(mx * mx + my * my) * (1.0 + ROUNDING) / w_min;
+        let axis = [mx, my].map(|v| v * (1.0 + ROUNDING) / w_min);
+        Some(Reach {
+            w_min,
+            w_max,
+            gx,
+            gy,
+            m,
+            axis,
+            c1,
+        })
+    }
+}
+
 impl Screen {
+    /// The screen of a frame of `config` at `S` subpixel bits drawn with
+    /// `mvp`; `None` for a non-finite matrix.
+    fn new<const S: u32>(mvp: &Mat4, config: &crate::Config) -> Option<Screen> {
+        let view = Projection::new(mvp, config)?;
+        let (gx, gy) = crate::fixed::guard_band_ndc::<S>(config.width, config.height);
+        let c = &mvp.cols;
+        let row = |i: usize| [c[0][i], c[1][i], c[2][i], c[3][i]];
+        let (rx, ry, rz, rw) = (row(0), row(1), row(2), row(3));
+        let comb = |a: [f32; 4], sa: f32, b: [f32; 4], sb: f32| -> [f32; 4] {
+            core::array::from_fn(|j| sa * a[j] + sb * b[j])
+        };
+        let planes = [
+            comb(rw, 1.0, rz, 1.0),
+            comb(rw, 1.0, rz, -1.0),
+            comb(rw, gx, rx, -1.0),
+            comb(rw, gx, rx, 1.0),
+            comb(rw, gy, ry, -1.0),
+            comb(rw, gy, ry, 1.0),
+        ]
+        .map(with_norm);
+        let screen = Screen {
+            view,
+            planes,
+            snap: 1.0 / (1u32 << (S + 1)) as f32,
+        };
+        screen.planes.iter().all(finite_form).then_some(screen)
+    }
+
+    /// Whether the ball of `radius` around `origin` lies inside near, far
+    /// and the guard band.
+    fn contains(&self, origin: [f32; 3], radius: f32) -> bool {
+        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
+        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
+        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+        self.planes
+            .iter()
+            .all(|(l, n)| at(l) > n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1)
+    }
+
     /// Whether every triangle of a node (within `radius` of `origin`;
     /// least doubled area `a_min`, least ratio `q` of doubled area to the
     /// sum of two edges, object units) whose facing values are at least
@@ -743,28 +887,24 @@ impl Screen {
         big: f32,
     ) -> bool {
         let [q, a_min] = size;
-        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
-        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
-        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
-        // A form's range over the node: centre value +- spread.
-        let spread = |l: &[f32; 4], n: f32| n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1;
-        for (l, n) in &self.planes {
-            if !(at(l) > spread(l, *n)) {
-                return false;
-            }
-        }
-        let [(rx, nx), (ry, ny), (rw, nw)] = &self.rows;
-        let (wc, wr) = (at(rw), spread(rw, *nw));
-        let (w_min, w_max) = (wc - wr, wc + wr);
-        if !(w_min > 0.0) {
+        if !self.contains(origin, radius) {
             return false;
         }
-        // |x/w| and |y/w| over the node.
-        let gx = (at(rx).abs() + spread(rx, *nx)) / w_min;
-        let gy = (at(ry).abs() + spread(ry, *ny)) / w_min;
-        let [hw, hh] = self.half;
-        let (mx, my) = (hw * (nx + gx * nw), hh * (ny + gy * nw));
-        let m = crate::math::fx::sqrt(mx * mx + my * my) * (1.0 + ROUNDING) / w_min;
+        let Some(Reach {
+            w_min,
+            w_max,
+            gx,
+            gy,
+            m,
+            c1,
+            ..
+        }) = self.view.reach(origin, radius)
+        else {
+            return false;
+        };
+        let [hw, hh] = self.view.half;
+        let [(rx, _), (ry, _), (rw, _)] = &self.view.rows;
+        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
         let x = phi * big * hw * hh / (w_max * w_max * w_max);
         // Rounding: the transform (3 roundings a row, 2^-22 relative to
         // |row|_1 |(p, 1)|_inf, through the division by w) and NDC to
@@ -814,10 +954,9 @@ impl ClusterNode {
         };
         match (f, &e.screen) {
             (Facing::Back, Some(sc)) => {
-                let v = &self.volume;
-                // The volume's sphere bounds the node (for cones too).
-                let sized = v.d_min <= v.d_max
-                    && sc.keeps_winding(v.origin, v.radius, self.size, phi, e.big);
+                let b = &self.sphere;
+                let centre = [b.center.x, b.center.y, b.center.z];
+                let sized = sc.keeps_winding(centre, b.radius, self.size, phi, e.big);
                 if sized {
                     Facing::Back
                 } else {
@@ -829,6 +968,55 @@ impl ClusterNode {
     }
 }
 
+/// Detail culling for a frame (lossy, [`Config::detail`](crate::Config::detail)
+/// pixels): a sphere wholly in front of the eye (`w > 0`) is dropped
+/// where its projection provably fits in a square less than `detail`
+/// pixels wide and high. The bound is the sphere's radius times the most
+/// pixels per object length along each axis over the sphere (the
+/// derivative of `x/w` and `y/w`, bounded as the size guard bounds it,
+/// with `f32` rounding allowed for), so every point of a dropped sphere,
+/// and every vertex of a dropped node, projects within that square about
+/// the centre's projection. [`BoundingSphere::EVERYWHERE`] (no bounds)
+/// is never dropped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Detail {
+    view: Projection,
+    pixels: f32,
+}
+
+impl Detail {
+    /// Detail culling for a frame of `config` drawn with `mvp`; `None`
+    /// where `config.detail` is 0 (off) or the matrix is not finite.
+    pub fn for_frame(mvp: &Mat4, config: &crate::Config) -> Option<Detail> {
+        if config.detail == 0 {
+            return None;
+        }
+        Some(Detail {
+            view: Projection::new(mvp, config)?,
+            pixels: f32::from(config.detail),
+        })
+    }
+
+    /// An upper bound on the width and height, in pixels, of the
+    /// projection of `sphere`; `None` where it is not wholly in front of
+    /// the eye or not finite.
+    pub fn extent(&self, sphere: &BoundingSphere) -> Option<f32> {
+        let c = [sphere.center.x, sphere.center.y, sphere.center.z];
+        let r = sphere.radius;
+        if !(r >= 0.0) || !c.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let [ax, ay] = self.view.reach(c, r)?.axis;
+        let d = 2.0 * r * ax.max(ay);
+        d.is_finite().then_some(d)
+    }
+
+    /// Whether `sphere` is dropped.
+    pub fn drops(&self, sphere: &BoundingSphere) -> bool {
+        self.extent(sphere).is_some_and(|d| d < self.pixels)
+    }
+}
+
 /// What a traversal decided for a run of clusters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Visit {
@@ -837,29 +1025,41 @@ pub enum Visit {
     /// Skip clusters `a..b` (back-facing), at a leaf (`false`) or an inner
     /// node (`true`).
     Cull(usize, usize, bool),
+    /// Drop clusters `a..b`: too small on screen ([`Detail`]).
+    Detail(usize, usize),
 }
 
 impl ClusterSet<'_> {
     /// The decisions [`Submit::submit_clusters`](crate::Submit::submit_clusters)
     /// makes, in cluster order, for a set that passed
     /// [`ClusterSet::validate`] (on any other set: some decisions, never a
-    /// panic). `eye == None` draws everything.
-    pub fn visit(&self, eye: Option<&Eye>, cull: ClusterCull, f: impl FnMut(Visit)) {
-        traverse(self, eye, cull, f);
+    /// panic). With neither an eye nor detail culling everything is drawn.
+    pub fn visit(
+        &self,
+        eye: Option<&Eye>,
+        detail: Option<&Detail>,
+        cull: ClusterCull,
+        f: impl FnMut(Visit),
+    ) {
+        traverse(self, eye, detail, cull, f);
     }
 }
 
-/// Walks a set, calling `f` for every decision in cluster order.
+/// Walks a set, calling `f` for every decision in cluster order. Detail
+/// is tested before facing; with detail culling on, a wholly
+/// front-facing inner node is still descended, so which clusters are
+/// dropped does not depend on the tree.
 pub(crate) fn traverse(
     set: &ClusterSet<'_>,
     eye: Option<&Eye>,
+    detail: Option<&Detail>,
     cull: ClusterCull,
     mut f: impl FnMut(Visit),
 ) {
-    let Some(eye) = eye else {
+    if eye.is_none() && detail.is_none() {
         f(Visit::Draw(0, set.clusters.len()));
         return;
-    };
+    }
     let mut i = 0usize;
     while let Some(node) = set.nodes.get(i) {
         let [a, b] = node.clusters.map(|v| v as usize);
@@ -870,20 +1070,25 @@ pub(crate) fn traverse(
             i += 1;
             continue;
         }
-        match node.facing(eye, cull.test) {
+        if detail.is_some_and(|d| d.drops(&node.sphere)) {
+            f(Visit::Detail(a, b));
+            i = skip;
+            continue;
+        }
+        match eye.map_or(Facing::Mixed, |e| node.facing(e, cull.test)) {
             Facing::Back => {
                 f(Visit::Cull(a, b, !leaf));
                 i = skip;
             }
-            Facing::Front => {
+            Facing::Front | Facing::Mixed if leaf => {
                 f(Visit::Draw(a, b));
                 i = skip;
             }
-            Facing::Mixed if leaf => {
+            Facing::Front if detail.is_none() => {
                 f(Visit::Draw(a, b));
                 i = skip;
             }
-            Facing::Mixed => i += 1,
+            Facing::Front | Facing::Mixed => i += 1,
         }
     }
 }
@@ -976,6 +1181,7 @@ mod tests {
             volume: CullVolume::NEVER,
             cone: NormalCone::NEVER,
             size: [0.0; 2],
+            sphere: BoundingSphere::EVERYWHERE,
         }
     }
 
@@ -1020,6 +1226,43 @@ mod tests {
                 vertices: &[],
             };
             assert!(s.validate(3, 5).is_err(), "{nodes:?}");
+        }
+    }
+
+    #[test]
+    fn detail_drops_small_far_spheres_only() {
+        let mut config = crate::Config::new(240, 240);
+        let mvp = camera();
+        assert!(Detail::for_frame(&mvp, &config).is_none(), "0 is off");
+        config.detail = 3;
+        let d = Detail::for_frame(&mvp, &config).unwrap();
+        // The camera is at z = 5 looking at the origin, with a field of
+        // view of 1 radian: 240 px span 2 tan(0.5) at distance 1.
+        let px_per_unit = 120.0 / (0.5f32).tan() / 5.0;
+        let ball = |x: f32, radius: f32| BoundingSphere {
+            center: Vec3::new(x, 0.0, 0.0),
+            radius,
+        };
+        let r = 1.0 / px_per_unit; // 2 px across at the origin
+        let e = d.extent(&ball(0.0, r)).unwrap();
+        assert!((2.0..2.0 * 1.01).contains(&e), "{e}");
+        // Off the axis the bound grows (|x/w| enters the derivative).
+        assert!(d.extent(&ball(1.0, r)).unwrap() > e);
+        assert!(d.drops(&ball(0.0, r)), "2 px is below 3");
+        assert!(!d.drops(&ball(0.0, 1.5 * r)), "3 px is kept");
+        assert!(!d.drops(&ball(0.0, 3.0 * r)), "6 px is kept");
+        // No bounds, a sphere reaching behind the eye, NaN: never dropped.
+        for b in [
+            BoundingSphere::EVERYWHERE,
+            BoundingSphere {
+                center: Vec3::new(0.0, 0.0, 5.0),
+                radius: r,
+            },
+            ball(f32::NAN, r),
+            ball(0.0, -1.0),
+            ball(0.0, f32::NAN),
+        ] {
+            assert!(!d.drops(&b), "{b:?}");
         }
     }
 }

@@ -98,7 +98,7 @@ pub use bins::Bins;
 pub use clip::ClipVertex;
 pub use color::{PixelFormat, TriangleId};
 pub use config::{Config, CullMode, Error, FrontFace};
-pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest};
+pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Detail};
 pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};

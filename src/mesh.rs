@@ -23,6 +23,13 @@ pub struct BoundingSphere {
 }
 
 impl BoundingSphere {
+    /// A sphere around everything (an infinite radius): bounds nothing
+    /// usefully, so nothing is culled or dropped by it.
+    pub const EVERYWHERE: BoundingSphere = BoundingSphere {
+        center: Vec3::new(0.0, 0.0, 0.0),
+        radius: f32::INFINITY,
+    };
+
     /// A sphere around every point (centre of the bounding box); `None`
     /// for no points or a non-finite coordinate.
     pub fn from_points(points: &[Vec3]) -> Option<BoundingSphere> {

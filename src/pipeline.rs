@@ -18,7 +18,7 @@
 
 use crate::clip::{clip_triangle, outcode, ClipVertex};
 use crate::config::Error;
-use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Eye, Visit};
+use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Detail, Eye, Visit};
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
@@ -222,7 +222,11 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     /// triangles it culls by winding (see [`crate::cull`]); data that does
     /// not fit the mesh is refused with
     /// [`Error::InvalidClusters`] before anything is done. Nothing is
-    /// culled by clusters under [`CullMode::None`](crate::CullMode).
+    /// culled by facing under [`CullMode::None`](crate::CullMode).
+    /// Detail culling ([`Config::detail`](crate::Config::detail), lossy,
+    /// off by default) drops nodes too small on screen in any cull mode
+    /// (see [`Detail`]), counted in [`Stats::culled_detail`]; the frame is
+    /// then no longer the per-triangle one.
     fn submit_clusters<A: Attributes<N>>(
         &mut self,
         mesh: &Mesh<'_, A>,
@@ -239,9 +243,10 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             return Ok(());
         }
         let eye = Eye::for_frame::<S>(mvp, &self.stage().config);
+        let detail = Detail::for_frame(mvp, &self.stage().config);
         let list = set.vertices;
         let drawn = |f: &mut dyn FnMut(&Cluster)| {
-            traverse(set, eye.as_ref(), cull, |v| {
+            traverse(set, eye.as_ref(), detail.as_ref(), cull, |v| {
                 if let Visit::Draw(a, b) = v {
                     set.clusters
                         .get(a..b)
@@ -296,6 +301,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             },
             set,
             eye,
+            detail,
             cull,
         };
         run_job::<S, N, _, _>(self.parts(), &job)
@@ -404,6 +410,16 @@ fn culled_object<K: ?Sized, A>(
             ..Stats::default()
         };
         return true;
+    }
+    if let Some(d) = Detail::for_frame(mvp, &parts.stage.config) {
+        if d.drops(&b) {
+            *parts.stats += Stats {
+                submitted: n,
+                culled_detail: n,
+                ..Stats::default()
+            };
+            return true;
+        }
     }
     // A strip renderer skips an object wholly above or below its strip.
     if let Some((top, bottom)) = parts.stage.slab {
@@ -685,19 +701,37 @@ struct ClusterJob<'m, A> {
     inner: ProcessedJob<'m, A>,
     set: &'m ClusterSet<'m>,
     eye: Option<Eye>,
+    detail: Option<Detail>,
     cull: ClusterCull,
+}
+
+/// Why [`ClusterJob::visit`] skipped a run of clusters.
+#[derive(Clone, Copy)]
+enum Skipped {
+    Leaf,
+    Inner,
+    Detail,
 }
 
 impl<A> ClusterJob<'_, A> {
     /// Calls `f(triangles, vertices)` for every cluster drawn, in order,
-    /// and `g(triangles, inner)` for every skipped run of clusters.
+    /// and `g(triangles, why)` for every skipped run of clusters.
     fn visit(
         &self,
         mut f: impl FnMut(core::ops::Range<usize>, core::ops::Range<usize>),
-        mut g: impl FnMut(u64, bool),
+        mut g: impl FnMut(u64, Skipped),
     ) {
         let clusters = self.set.clusters;
-        traverse(self.set, self.eye.as_ref(), self.cull, |v| match v {
+        let count = |a: usize, b: usize| -> u64 {
+            clusters
+                .get(a..b)
+                .unwrap_or(&[])
+                .iter()
+                .map(|k| u64::from(k.triangles[1].saturating_sub(k.triangles[0])))
+                .sum()
+        };
+        let (eye, detail) = (self.eye.as_ref(), self.detail.as_ref());
+        traverse(self.set, eye, detail, self.cull, |v| match v {
             Visit::Draw(a, b) => {
                 for k in clusters.get(a..b).unwrap_or(&[]) {
                     let [t0, t1] = k.triangles.map(|v| v as usize);
@@ -712,14 +746,12 @@ impl<A> ClusterJob<'_, A> {
                 }
             }
             Visit::Cull(a, b, inner) => {
-                let tris = clusters
-                    .get(a..b)
-                    .unwrap_or(&[])
-                    .iter()
-                    .map(|k| u64::from(k.triangles[1].saturating_sub(k.triangles[0])))
-                    .sum();
-                g(tris, inner);
+                g(
+                    count(a, b),
+                    if inner { Skipped::Inner } else { Skipped::Leaf },
+                );
             }
+            Visit::Detail(a, b) => g(count(a, b), Skipped::Detail),
         });
     }
 }
@@ -770,12 +802,12 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
                 self.inner
                     .run_range::<S, N, K>(stage, stats, sink, tris, verts)
             },
-            |tris, inner| {
+            |tris, why| {
                 skipped.submitted += tris;
-                if inner {
-                    skipped.culled_hierarchy += tris;
-                } else {
-                    skipped.culled_cluster += tris;
+                match why {
+                    Skipped::Leaf => skipped.culled_cluster += tris,
+                    Skipped::Inner => skipped.culled_hierarchy += tris,
+                    Skipped::Detail => skipped.culled_detail += tris,
                 }
             },
         );

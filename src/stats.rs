@@ -49,6 +49,10 @@ pub struct Stats {
     /// Skipped like `culled_cluster`, by an inner node of the cluster
     /// tree (a whole subtree at once).
     pub culled_hierarchy: u64,
+    /// Skipped before transform by detail culling (lossy, off by
+    /// default): an object, or a cluster-tree node, whose projected bound
+    /// is below [`Config::detail`](crate::Config::detail) pixels across.
+    pub culled_detail: u64,
 }
 
 impl Stats {
@@ -65,6 +69,7 @@ impl Stats {
             self.outside_strip,
             self.culled_cluster,
             self.culled_hierarchy,
+            self.culled_detail,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
@@ -85,6 +90,7 @@ impl Stats {
             outside_strip: self.outside_strip.saturating_add(o.outside_strip),
             culled_cluster: self.culled_cluster.saturating_add(o.culled_cluster),
             culled_hierarchy: self.culled_hierarchy.saturating_add(o.culled_hierarchy),
+            culled_detail: self.culled_detail.saturating_add(o.culled_detail),
         }
     }
 }

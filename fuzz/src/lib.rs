@@ -946,6 +946,7 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         outside_strip: b.outside_strip - a.outside_strip,
         culled_cluster: b.culled_cluster - a.culled_cluster,
         culled_hierarchy: b.culled_hierarchy - a.culled_hierarchy,
+        culled_detail: b.culled_detail - a.culled_detail,
     }
 }
 

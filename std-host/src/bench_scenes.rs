@@ -391,6 +391,7 @@ mod tests {
             width,
             height,
             cull: CullMode::Back,
+            detail: 0,
             depth,
             subpixel: 8,
             threads: 1,

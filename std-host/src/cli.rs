@@ -223,6 +223,12 @@ pub struct RenderArgs {
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
 
+    /// Detail culling (lossy; 0: off): drop objects, and with
+    /// --cull-clusters clusters, whose projection is provably less than PX
+    /// pixels across, before transform.
+    #[arg(long, value_name = "PX", default_value_t = 0)]
+    pub cull_detail: u16,
+
     /// Depth buffer format.
     #[arg(long, value_enum, default_value_t = DepthArg::U32)]
     pub depth: DepthArg,
@@ -442,6 +448,12 @@ pub struct BenchArgs {
     /// cones, at the leaves or down the tree.
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
+
+    /// Detail culling (lossy; 0: off): drop objects, and with
+    /// --cull-clusters clusters, whose projection is provably less than PX
+    /// pixels across, before transform.
+    #[arg(long, value_name = "PX", default_value_t = 0)]
+    pub cull_detail: u16,
 
     /// Depth buffer format [default: u16 for sphere, else u32].
     #[arg(long, value_enum)]
@@ -779,6 +791,12 @@ pub struct CullArgs {
     /// ranges, no vertex list) instead of sharing them.
     #[arg(long)]
     pub copies: bool,
+
+    /// Also measure detail culling at PX pixels (a row "culling volumes,
+    /// tree, detail"; lossy: its pixels differing are reported; 0: no
+    /// such row).
+    #[arg(long, value_name = "PX", default_value_t = 0)]
+    pub detail: u16,
 
     /// Also write the measurements as JSON.
     #[arg(long, value_name = "FILE")]

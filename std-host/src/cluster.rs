@@ -253,6 +253,7 @@ fn node(mesh: &ClusteredMesh, a: usize, b: usize) -> ClusterNode {
         volume,
         cone: NormalCone::from_triangles(&mesh.positions, tris),
         size: microraster::cull::triangle_sizes(&mesh.positions, tris),
+        sphere: microraster::cull::triangle_sphere(&mesh.positions, tris),
     }
 }
 

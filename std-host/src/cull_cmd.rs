@@ -18,7 +18,7 @@
 
 use crate::cli::CullArgs;
 use crate::cluster::{self, ClusterOptions, ClusteredMesh};
-use microraster::cull::{Eye, Visit};
+use microraster::cull::{Detail, Eye, Visit};
 use microraster::prelude::*;
 use microraster::{
     BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
@@ -43,6 +43,9 @@ pub enum Method {
     Cones,
     /// Normal cones, tree top-down.
     ConesTree,
+    /// Culling volumes, tree top-down, with detail culling (lossy; only
+    /// with `--detail`).
+    Detail,
 }
 
 impl Method {
@@ -56,11 +59,13 @@ impl Method {
         Method::ConesTree,
     ];
 
+    /// The setting (detail culling for [`Method::Detail`] is in the
+    /// frame's `Config::detail`).
     fn cull(self) -> Option<ClusterCull> {
         let (test, hierarchy) = match self {
             Method::Source | Method::Clustered => return None,
             Method::Volumes => (ClusterTest::Volumes, false),
-            Method::VolumesTree => (ClusterTest::Volumes, true),
+            Method::VolumesTree | Method::Detail => (ClusterTest::Volumes, true),
             Method::Cones => (ClusterTest::Cones, false),
             Method::ConesTree => (ClusterTest::Cones, true),
         };
@@ -75,6 +80,7 @@ impl Method {
             Method::VolumesTree => "culling volumes, tree",
             Method::Cones => "normal cones, leaves",
             Method::ConesTree => "normal cones, tree",
+            Method::Detail => "culling volumes, tree, detail",
         }
     }
 }
@@ -97,8 +103,12 @@ pub struct Row {
     pub geometry_ms: [f64; 3],
     /// Whole frame, ms per frame: median, min, max.
     pub frame_ms: [f64; 3],
-    /// Cameras whose frame differed from per-triangle culling (must be 0).
+    /// Cameras whose frame differed from per-triangle culling (must be 0
+    /// but for detail culling).
     pub frames_differing: usize,
+    /// Pixels whose colour differed from per-triangle culling, per frame
+    /// (mean; 0 but for detail culling).
+    pub pixels_differing: f64,
 }
 
 /// What one model measured.
@@ -180,6 +190,8 @@ pub fn cameras(positions: &[Vec3], n: usize, dist: f32, aspect: f32) -> Result<V
 struct Case<'a> {
     mesh: Mesh<'a>,
     set: Option<(&'a ClusteredMesh, ClusterCull)>,
+    /// The frame's settings (with detail culling for [`Method::Detail`]).
+    config: Config,
 }
 
 /// Submits one frame; returns its stats.
@@ -198,14 +210,15 @@ fn submit(
 }
 
 /// Vertices a frame transforms.
-fn vertices_transformed(case: &Case<'_>, mvp: &Mat4, config: &Config) -> usize {
+fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
     let Some((c, cull)) = case.set else {
         return case.mesh.positions.len();
     };
-    let eye = Eye::for_frame::<8>(mvp, config);
+    let eye = Eye::for_frame::<8>(mvp, &case.config);
+    let detail = Detail::for_frame(mvp, &case.config);
     let mut seen = vec![false; c.positions.len()];
     let mut n = 0;
-    c.set().visit(eye.as_ref(), cull, |v| {
+    c.set().visit(eye.as_ref(), detail.as_ref(), cull, |v| {
         if let Visit::Draw(a, b) = v {
             for k in &c.clusters[a..b] {
                 let r = k.vertices[0] as usize..k.vertices[1] as usize;
@@ -256,11 +269,19 @@ fn measure(
         attributes: MeshColors::PerTriangle(&colors),
         bounds: None,
     };
-    let cases: Vec<Case<'_>> = Method::ALL
+    let mut methods = Method::ALL.to_vec();
+    if args.detail > 0 {
+        methods.push(Method::Detail);
+    }
+    let cases: Vec<Case<'_>> = methods
         .iter()
         .map(|m| Case {
             mesh: if *m == Method::Source { source } else { cmesh },
             set: m.cull().map(|c| (clustered, c)),
+            config: Config {
+                detail: if *m == Method::Detail { args.detail } else { 0 },
+                ..config
+            },
         })
         .collect();
     let cap = clustered.indices.len().max(indices.len()) * 2 + 64;
@@ -271,7 +292,7 @@ fn measure(
     let (mut color, mut depth) = (vec![Rgb888::BLACK; n], vec![u16::MAX; n]);
 
     // Counts and the identical-frame check, once per camera.
-    let mut rows: Vec<Row> = Method::ALL
+    let mut rows: Vec<Row> = methods
         .iter()
         .map(|&method| Row {
             method,
@@ -282,30 +303,35 @@ fn measure(
             geometry_ms: [0.0; 3],
             frame_ms: [0.0; 3],
             frames_differing: 0,
+            pixels_differing: 0.0,
         })
         .collect();
     let cams = mvps.len().max(1) as f64;
     for mvp in &mvps {
-        let mut want: Option<Vec<u8>> = None;
+        let mut want: Option<(Vec<u8>, Vec<Rgb888>)> = None;
         for (row, case) in rows.iter_mut().zip(&cases) {
-            let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
+            let mut frame = Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
             let s = submit(&mut frame, case, mvp, &mut cache)?;
             color.fill(Rgb888::BLACK);
             depth.fill(u16::MAX);
             frame
                 .render_rows(0, h, &mut color, &mut depth[..])
                 .map_err(|e| e.to_string())?;
-            let skipped = s.culled_cluster + s.culled_hierarchy;
+            let skipped = s.culled_cluster + s.culled_hierarchy + s.culled_detail;
             row.triangles_to_transform += (s.submitted - skipped) as f64 / cams;
             row.removed_before_transform += skipped as f64 / s.submitted.max(1) as f64 / cams;
-            row.vertices_transformed += vertices_transformed(case, mvp, &config) as f64 / cams;
+            row.vertices_transformed += vertices_transformed(case, mvp) as f64 / cams;
             row.triangles_set_up += s.stored as f64 / cams;
             if row.method != Method::Source {
                 let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
                 bytes.extend(depth.iter().flat_map(|d| d.to_le_bytes()));
                 match &want {
-                    None => want = Some(bytes),
-                    Some(w) if *w != bytes => row.frames_differing += 1,
+                    None => want = Some((bytes, color.clone())),
+                    Some((w, c)) if *w != bytes => {
+                        row.frames_differing += 1;
+                        let n = c.iter().zip(&color).filter(|(a, b)| a != b).count();
+                        row.pixels_differing += n as f64 / cams;
+                    }
                     Some(_) => {}
                 }
             }
@@ -321,7 +347,7 @@ fn measure(
             let (mut g, mut f) = (0.0f64, 0.0f64);
             for mvp in &mvps {
                 let t0 = Instant::now();
-                let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
+                let mut frame = Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
                 submit(&mut frame, case, mvp, &mut cache)?;
                 let t1 = Instant::now();
                 color.fill(Rgb888::BLACK);
@@ -412,7 +438,11 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
         for row in &r.rows {
             s += &format!(
                 "| {} | {:.0} | {:.1} % | {:.0} | {:.0} | {:.3} ({:.3}-{:.3}) | {:.3} ({:.3}-{:.3}) | {} |\n",
-                row.method.label(),
+                if row.method == Method::Detail {
+                    format!("{} {} px", row.method.label(), args.detail)
+                } else {
+                    row.method.label().to_string()
+                },
                 row.triangles_to_transform,
                 row.removed_before_transform * 100.0,
                 row.vertices_transformed,
@@ -423,7 +453,14 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
                 row.frame_ms[0],
                 row.frame_ms[1],
                 row.frame_ms[2],
-                if row.method == Method::Source { "-".to_string() } else { row.frames_differing.to_string() },
+                match row.method {
+                    Method::Source => "-".to_string(),
+                    Method::Detail => format!(
+                        "{} ({:.1} pixels a frame)",
+                        row.frames_differing, row.pixels_differing
+                    ),
+                    _ => row.frames_differing.to_string(),
+                },
             );
         }
     }

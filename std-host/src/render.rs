@@ -42,6 +42,8 @@ pub struct RenderOptions {
     pub height: u32,
     /// Face culling.
     pub cull: CullMode,
+    /// Detail culling in pixels (`Config::detail`; 0: off).
+    pub detail: u16,
     /// Depth buffer.
     pub depth: DepthKind,
     /// Subpixel bits: 4 or 8.
@@ -102,6 +104,8 @@ pub struct Counters {
     pub culled_cluster: u64,
     /// Skipped by an inner node of the cluster tree.
     pub culled_hierarchy: u64,
+    /// Dropped before transform by detail culling (`--cull-detail`).
+    pub culled_detail: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -118,6 +122,7 @@ impl From<&Stats> for Counters {
             stored: s.stored,
             culled_cluster: s.culled_cluster,
             culled_hierarchy: s.culled_hierarchy,
+            culled_detail: s.culled_detail,
         }
     }
 }
@@ -184,6 +189,7 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
+    config.detail = opts.detail;
     let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
     let len = w as usize * h as usize;
     let t0 = Instant::now();
@@ -266,6 +272,7 @@ mod tests {
             width: 160,
             height: 120,
             cull: CullMode::Back,
+            detail: 0,
             depth,
             subpixel: 8,
             threads,

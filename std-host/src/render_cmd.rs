@@ -310,6 +310,10 @@ fn nonzero(c: &Counters) -> String {
             "back-facing cluster tree node (before transform)",
             c.culled_hierarchy,
         ),
+        (
+            "cluster below --cull-detail pixels (before transform)",
+            c.culled_detail,
+        ),
         ("degenerate", c.culled_degenerate),
         ("non-finite", c.rejected_nonfinite),
         ("index out of range", c.rejected_index),
@@ -363,6 +367,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             CullArg::Front => CullMode::Front,
             CullArg::None => CullMode::None,
         },
+        detail: args.cull_detail,
         depth: match args.depth {
             DepthArg::U16 => DepthKind::U16,
             DepthArg::U32 => DepthKind::U32,

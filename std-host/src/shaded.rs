@@ -328,6 +328,7 @@ impl Job<'_> {
         let (w, h) = (opts.width, opts.height);
         let mut config = Config::new(w, h);
         config.cull = opts.cull;
+        config.detail = opts.detail;
         let mesh = Mesh {
             positions: &model.positions,
             indices: &model.indices,
@@ -516,6 +517,7 @@ mod tests {
             width: 64,
             height: 48,
             cull: microraster::CullMode::Back,
+            detail: 0,
             depth: DepthKind::U16,
             subpixel: 8,
             threads,

@@ -201,6 +201,7 @@ fn a_clustered_scene_renders_the_same_image_on_threads() {
         width: 200,
         height: 150,
         cull: microraster::CullMode::Back,
+        detail: 0,
         depth: DepthKind::U16,
         subpixel: 8,
         threads,

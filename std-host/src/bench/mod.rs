@@ -85,6 +85,8 @@ pub struct Settings {
     pub strip_rows: u32,
     /// Face culling.
     pub cull: CullMode,
+    /// Detail culling in pixels (0: off).
+    pub detail: u16,
     /// Depth format.
     pub depth: DepthArg,
     /// Colour format.
@@ -132,6 +134,7 @@ pub fn settings(args: &BenchArgs, name: Option<&str>) -> Settings {
             CullArg::Front => CullMode::Front,
             CullArg::None => CullMode::None,
         },
+        detail: args.cull_detail,
         depth: args
             .depth
             .unwrap_or(if sphere { DepthArg::U16 } else { DepthArg::U32 }),
@@ -551,6 +554,7 @@ mod tests {
                 width: 96,
                 height: 72,
                 cull: CullMode::Back,
+                detail: 0,
                 depth: if scene == "sphere" {
                     DepthKind::U16
                 } else {

@@ -56,6 +56,7 @@ impl BenchColor for Rgb565 {
 pub fn config_of(s: &Settings) -> Config {
     let mut c = Config::new(s.width, s.height);
     c.cull = s.cull;
+    c.detail = s.detail;
     c
 }
 
@@ -345,6 +346,7 @@ fn render_fn_section(
         width: s.width,
         height: s.height,
         cull: s.cull,
+        detail: s.detail,
         depth: match s.depth {
             DepthArg::U16 => DepthKind::U16,
             DepthArg::U32 => DepthKind::U32,
