@@ -80,6 +80,24 @@ for r in reports:
     print(f'{r["model"]}: removed before transform {", ".join(f"{c:.3f}" for c in culled)}')
 PY
 
+# Detail culling (lossy): far away, it drops more than the exact tree and
+# reports the pixels it changed.
+echo "+ microraster cull --cameras 8 --rounds 1 --distance 10 --detail 2"
+"$bin" cull --cameras 8 --rounds 1 --distance 10 --detail 2 --json "$out/cull-detail.json" >"$out/cull-detail.md"
+python3 - "$out/cull-detail.json" <<'PY'
+import json, sys
+reports = json.load(open(sys.argv[1]))
+for r in reports:
+    rows = {row["method"]: row for row in r["rows"]}
+    tree, detail = rows["volumes-tree"], rows["detail"]
+    assert tree["frames_differing"] == 0, (r["model"], tree)
+    assert detail["removed_before_transform"] >= tree["removed_before_transform"], r["model"]
+    assert (detail["frames_differing"] == 0) == (detail["pixels_differing"] == 0), detail
+    print(f'{r["model"]}: detail 2 px removes {detail["removed_before_transform"]:.3f}, '
+          f'{detail["pixels_differing"]:.1f} pixels a frame changed')
+assert any(r["rows"][-1]["pixels_differing"] > 0 for r in reports)
+PY
+
 if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
   cargo bench -q -p microraster-host --features criterion --bench core --no-run
 fi
