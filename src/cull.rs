@@ -1236,9 +1236,12 @@ mod tests {
         assert!(Detail::for_frame(&mvp, &config).is_none(), "0 is off");
         config.detail = 3;
         let d = Detail::for_frame(&mvp, &config).unwrap();
-        // The camera is at z = 5 looking at the origin, with a field of
-        // view of 1 radian: 240 px span 2 tan(0.5) at distance 1.
-        let px_per_unit = 120.0 / (0.5f32).tan() / 5.0;
+        // The camera is at z = 5 looking at the origin: along x, about
+        // the origin, a unit moves x/w by `r_x[0] / w` (read from the
+        // matrix itself, so the approximate `tan` of the micromath
+        // backend changes nothing here), times 120 px.
+        let c = &mvp.cols;
+        let px_per_unit = 120.0 * c[0][0] / c[3][3];
         let ball = |x: f32, radius: f32| BoundingSphere {
             center: Vec3::new(x, 0.0, 0.0),
             radius,
