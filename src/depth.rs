@@ -96,6 +96,34 @@ pub trait DepthBuffer {
     ) -> u32 {
         flat_span_each(self, color, start, len, z0, dz, func, write, px)
     }
+
+    /// [`flat_span`](DepthBuffer::flat_span) with `func` `Less` (or
+    /// `LessEqual` when `le`), writes on, `F = 0`, and a depth the caller
+    /// has proved to stay in `[0, 2^32)` over the span: `z0 + n * dz`
+    /// (wrapping `u32` sums of `dz`'s low half) is then the exact `Z32`,
+    /// with no clamp. Only
+    /// called for buffers with [`FRAC`](DepthBuffer::FRAC) 0. The
+    /// rasterizer's fast path for `u16` buffers.
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn flat_span_in_range<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: u32,
+        dz: i64,
+        le: bool,
+        px: C,
+    ) -> u32 {
+        let func = if le {
+            DepthFunc::LessEqual
+        } else {
+            DepthFunc::Less
+        };
+        self.flat_span(color, start, len, z0 as i64, dz, func, true, px)
+    }
 }
 
 /// The pixel-by-pixel span loop behind [`DepthBuffer::flat_span`].
@@ -181,6 +209,31 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
             }
             z = z.wrapping_add(dz);
         }
+    }
+    written
+}
+
+/// [`span_unclamped`] for `Z32.0` words (`u16` buffers), with the start
+/// and step in one register each: the loop behind
+/// [`DepthBuffer::flat_span_in_range`] on 32-bit cores.
+#[inline(never)]
+fn span_z32<W: DepthWord, C: Copy, const LE: bool>(
+    c: &mut [C],
+    d: &mut [W],
+    z0: u32,
+    dz: u32,
+    px: C,
+) -> u32 {
+    let mut written = 0u32;
+    let mut z = z0;
+    for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+        let (key, old) = (W::key_in_range(z as u64), (*dp).key());
+        if key < old || (LE && key == old) {
+            *dp = W::from_fixed_in_range(z as u64);
+            *cp = px;
+            written += 1;
+        }
+        z = z.wrapping_add(dz);
     }
     written
 }
@@ -357,6 +410,47 @@ impl<W: DepthWord> DepthBuffer for [W] {
         written
     }
 
+    #[inline(always)]
+    fn flat_span_in_range<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: u32,
+        dz: i64,
+        le: bool,
+        px: C,
+    ) -> u32 {
+        debug_assert!(W::FRAC == 0);
+        debug_assert!(
+            len == 0 || (0..1i128 << 32).contains(&(z0 as i128 + dz as i128 * (len as i128 - 1))),
+            "span leaves [0, 2^32): z0 {z0} dz {dz} len {len}"
+        );
+        let end = start.saturating_add(len);
+        let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end)) else {
+            return 0;
+        };
+        if cfg!(target_pointer_width = "64") {
+            // Branch-free for the host's vectors, the same unclamped words.
+            let (mut z, dz) = (z0, dz as u32);
+            let mut written = 0u32;
+            for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+                let zw = W::from_fixed_in_range(z as u64);
+                let pass = zw < *dp || (le && zw == *dp);
+                *dp = if pass { zw } else { *dp };
+                *cp = if pass { px } else { *cp };
+                written += pass as u32;
+                z = z.wrapping_add(dz);
+            }
+            return written;
+        }
+        if le {
+            span_z32::<W, C, true>(c, d, z0, dz as u32, px)
+        } else {
+            span_z32::<W, C, false>(c, d, z0, dz as u32, px)
+        }
+    }
+
     fn depth_len(&self) -> Option<usize> {
         Some(self.len())
     }
@@ -396,6 +490,20 @@ impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
         px: C,
     ) -> u32 {
         self[..].flat_span(color, start, len, z0, dz, func, write, px)
+    }
+
+    #[inline(always)]
+    fn flat_span_in_range<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: u32,
+        dz: i64,
+        le: bool,
+        px: C,
+    ) -> u32 {
+        self[..].flat_span_in_range(color, start, len, z0, dz, le, px)
     }
 
     fn depth_len(&self) -> Option<usize> {

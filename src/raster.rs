@@ -38,6 +38,16 @@
 //! strip split (IEEE arithmetic is deterministic, in software on FPU-less
 //! cores too).
 //!
+//! A flat triangle's span rows run in a loop of their own (`flat_rows`),
+//! out of line so that only the depth state is live in it. For a `u16`
+//! buffer under `Less` or `LessEqual` with writes, a triangle whose vertex
+//! depths keep `2^14 + width` `Z32` units from both planes
+//! (`z_never_clamps`, with its error bound) provably never steps a span
+//! out of `[0, 2^32)`: its spans skip the per-span range check and the
+//! clamp, and step one `u32` (`flat_rows_in_range`). The words are the
+//! ones the checked path writes (a property test compares the two on
+//! depths a few `f32` steps from the planes).
+//!
 //! Varyings, when they vary, are perspective-correct: `sum(E_k v_k / w_k)
 //! / sum(E_k / w_k)` with the exact edge values converted to `f32` at the
 //! start of each run and the `N + 1` sums stepped in `f32` along it; one
@@ -265,6 +275,9 @@ trait Real: Copy + core::ops::Add<Output = Self> + core::ops::Mul<Output = Self>
     /// `self * 2^frac` (`frac` 0 or 16: `Z32.F` from `Z32`), rounded half
     /// away from zero, saturating.
     fn to_fixed(self, frac: u32) -> i64;
+    /// `to_fixed(0)` of a value in `[0, 2^32 - 1)`: `self + 0.5`
+    /// truncated, one conversion.
+    fn round_in_range(self) -> u32;
 }
 
 macro_rules! impl_real {
@@ -290,6 +303,10 @@ macro_rules! impl_real {
             #[inline(always)]
             fn to_u32(self) -> u32 {
                 self as u32
+            }
+            #[inline(always)]
+            fn round_in_range(self) -> u32 {
+                (self + 0.5) as u32
             }
             #[inline(always)]
             fn to_fixed(self, frac: u32) -> i64 {
@@ -327,6 +344,8 @@ struct Shader<R, const N: usize> {
     dv: [f32; N],
     dw: f32,
     smooth: bool,
+    /// [`z_never_clamps`] for the triangle's depths and box.
+    unclamped: bool,
 }
 
 /// Interpolants at one pixel: depth, varying numerators, denominator.
@@ -376,6 +395,22 @@ impl<R: Real, const N: usize> Shader<R, N> {
             dv,
             dw,
             smooth,
+            unclamped: D::ENABLED
+                && D::FRAC == 0
+                && z_never_clamps(t.z, (t.max_x - t.min_x) as usize),
+        }
+    }
+
+    /// Depth at the pixel whose biased edge values 1 and 2 are `e1`, `e2`
+    /// (0 without a depth buffer).
+    #[inline(always)]
+    fn z_at<D: DepthBuffer + ?Sized, T: EdgeInt>(&self, e1: T, e2: T) -> R {
+        if D::ENABLED {
+            self.z0
+                + self.k1 * e1.unbiased::<R>(self.bias[1])
+                + self.k2 * e2.unbiased::<R>(self.bias[2])
+        } else {
+            R::ZERO
         }
     }
 
@@ -387,13 +422,7 @@ impl<R: Real, const N: usize> Shader<R, N> {
         t: &SetupTriangle<N>,
         e: [T; 3],
     ) -> Acc<R, N> {
-        let z = if D::ENABLED {
-            self.z0
-                + self.k1 * e[1].unbiased::<R>(self.bias[1])
-                + self.k2 * e[2].unbiased::<R>(self.bias[2])
-        } else {
-            R::ZERO
-        };
+        let z = self.z_at::<D, T>(e[1], e[2]);
         let mut v = [0.0f32; N];
         let mut w = 0.0f32;
         if self.smooth {
@@ -588,31 +617,27 @@ fn draw_in<
         return written;
     }
 
+    if !shader.smooth {
+        // Flat: no varyings to step, so the rows take a loop of their own
+        // with only the depth state live (out of line, its registers are
+        // not the smooth path's).
+        return flat_rows::<N, C, D, R, T>(
+            edges,
+            &shader,
+            row_last - row_first + 1,
+            base,
+            max_n,
+            strip,
+            flat,
+        );
+    }
     for _ in row_first..=row_last {
         let mut lo = T::ZERO;
         let mut hi = T::from_usize(max_n);
         let covered = edges[0].clip_span(&mut lo, &mut hi)
             && edges[1].clip_span(&mut lo, &mut hi)
             && edges[2].clip_span(&mut lo, &mut hi);
-        if covered && !shader.smooth {
-            // Flat span: one colour, depth stepped in Z32.F from the span's
-            // exact start (error below 1/8 LSB over 2^14 pixels), in the
-            // depth buffer's branch-free loop.
-            let e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
-            let z0 = shader.start::<D, T>(t, e).z;
-            let px = flat;
-            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
-            written += strip.depth.flat_span(
-                strip.color,
-                base + lo,
-                hi - lo + 1,
-                z0.to_fixed(D::FRAC),
-                shader.dz_fixed,
-                strip.depth_func,
-                strip.depth_write,
-                px,
-            );
-        } else if covered {
+        if covered {
             let mut e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
             let mut acc = shader.start::<D, T>(t, e);
             // Depth exactly as on a flat span (the same Z32.F steps from
@@ -632,6 +657,136 @@ fn draw_in<
                 e[2] += edges[2].step_x;
                 shader.step::<D>(&mut acc);
             }
+        }
+        for edge in edges.iter_mut() {
+            edge.row += edge.step_y;
+        }
+        base += strip.width;
+    }
+    written
+}
+
+/// The span rows of a flat triangle (one colour, so only depth varies):
+/// per row the exact span, its depth start from the exact edge values,
+/// then the depth buffer's flat-span loop. The same pixels and depths as
+/// the smooth path's spans (the same `Z32.F` steps from the same start).
+#[inline(never)]
+fn flat_rows<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
+    mut edges: [Edge<T>; 3],
+    shader: &Shader<R, N>,
+    rows: u32,
+    mut base: usize,
+    max_n: usize,
+    strip: &mut Strip<'_, C, D>,
+    px: C,
+) -> u32 {
+    if shader.unclamped
+        && strip.depth_write
+        && matches!(strip.depth_func, DepthFunc::Less | DepthFunc::LessEqual)
+    {
+        return flat_rows_in_range::<N, C, D, R, T>(edges, shader, rows, base, max_n, strip, px);
+    }
+    let mut written = 0u32;
+    for _ in 0..rows {
+        let mut lo = T::ZERO;
+        let mut hi = T::from_usize(max_n);
+        let covered = edges[0].clip_span(&mut lo, &mut hi)
+            && edges[1].clip_span(&mut lo, &mut hi)
+            && edges[2].clip_span(&mut lo, &mut hi);
+        if covered {
+            // Depth stepped in Z32.F from the span's exact start (error
+            // below 1/8 LSB over 2^14 pixels), in the depth buffer's
+            // branch-free loop.
+            let z0 = shader.z_at::<D, T>(edges[1].at(lo), edges[2].at(lo));
+            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
+            written += strip.depth.flat_span(
+                strip.color,
+                base + lo,
+                hi - lo + 1,
+                z0.to_fixed(D::FRAC),
+                shader.dz_fixed,
+                strip.depth_func,
+                strip.depth_write,
+                px,
+            );
+        }
+        for edge in edges.iter_mut() {
+            edge.row += edge.step_y;
+        }
+        base += strip.width;
+    }
+    written
+}
+
+/// Whether every depth the rows of a triangle with vertex depths `z`
+/// (`Z32`) and a box `max_n + 1` pixels wide step through stays in `[0,
+/// 2^32)`, for `Z32.0` spans started in `f32` ([`Shader::z_at`]): then no
+/// span needs [`in_range_throughout`](crate::depth) or a clamp.
+///
+/// Proof. At a covered pixel the exact plane is `Z0 + (Z1 - Z0) b1 + (Z2 -
+/// Z0) b2` with barycentrics `b` in `[0, 1]`, so it lies in `[min Z, max
+/// Z]`. In `f32` (unit roundoff `u = 2^-24`) `k1 = fl(fl(Z1 - Z0) fl(1 /
+/// area))` carries a relative error below `3u`, the edge value's
+/// conversion `u` and the product `u`: the term `k1 e1` is off by at most
+/// `5u |Z1 - Z0| < 5u 2^32 = 1280`, and so is `k2 e2`; `Z0`'s conversion
+/// adds 256 and the two sums at most 512 each (their values stay below
+/// `2^33`): the span's start is within 3,840 of the plane. Adding `0.5`
+/// and truncating adds at most 257. The step `dz = fl(fl(k1 sx1) + fl(k2
+/// sx2))` is off by at most `5u (|k1 sx1| + |k2 sx2|) + u |dz|`; over a
+/// span of `n` steps between two covered pixels `n |k1 sx1| = |Z1 - Z0|
+/// |Δb1| < 2^32` (both ends have `b1` in `[0, 1]`), so the drift is below
+/// `6u 2^33 = 3,072`, plus `n / 2 <= max_n / 2` from rounding `dz` to an
+/// integer. Every stepped value is within `7,169 + max_n / 2 < 2^13 +
+/// max_n` of a value in `[min Z, max Z]`, and a margin of `2^14 + max_n`
+/// on both sides leaves it in range (the debug assertion in
+/// `flat_span_in_range` checks every span of the property tests).
+#[inline]
+fn z_never_clamps(z: [u32; 3], max_n: usize) -> bool {
+    let margin = (1u64 << 14) + max_n as u64;
+    let lo = z[0].min(z[1]).min(z[2]) as u64;
+    let hi = z[0].max(z[1]).max(z[2]) as u64;
+    lo >= margin && hi + margin < 1 << 32
+}
+
+/// [`flat_rows`] where [`z_never_clamps`] holds for a `Z32.0` buffer
+/// under `Less` or `LessEqual` with writes: the span's start is converted
+/// straight to `u32` (`to_fixed` gives the same integer for a value in
+/// range) and every span goes to the unclamped loop.
+fn flat_rows_in_range<
+    const N: usize,
+    C: PixelFormat,
+    D: DepthBuffer + ?Sized,
+    R: Real,
+    T: EdgeInt,
+>(
+    mut edges: [Edge<T>; 3],
+    shader: &Shader<R, N>,
+    rows: u32,
+    mut base: usize,
+    max_n: usize,
+    strip: &mut Strip<'_, C, D>,
+    px: C,
+) -> u32 {
+    let le = strip.depth_func == DepthFunc::LessEqual;
+    let mut written = 0u32;
+    for _ in 0..rows {
+        let mut lo = T::ZERO;
+        let mut hi = T::from_usize(max_n);
+        let covered = edges[0].clip_span(&mut lo, &mut hi)
+            && edges[1].clip_span(&mut lo, &mut hi)
+            && edges[2].clip_span(&mut lo, &mut hi);
+        if covered {
+            let z0 = shader.z_at::<D, T>(edges[1].at(lo), edges[2].at(lo));
+            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
+            written += strip.depth.flat_span_in_range(
+                strip.color,
+                base + lo,
+                hi - lo + 1,
+                z0.round_in_range(),
+                shader.dz_fixed,
+                le,
+                px,
+            );
         }
         for edge in edges.iter_mut() {
             edge.row += edge.step_y;

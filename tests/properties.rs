@@ -1180,3 +1180,63 @@ fn an_object_above_the_strip_is_skipped_whole() {
         }
     }
 }
+
+/// An NDC depth near a plane, or anywhere: within 3e-5 of -1 or 1 (window
+/// depth within about 2^16 `Z32` units of 0 or 1, around the margin of the
+/// rasterizer's unclamped span path), a few `f32` steps from them (tens to
+/// hundreds of `Z32` units, where a missing margin would show), or uniform
+/// in [-1, 1].
+fn near_plane_depth() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        (0.0f32..3e-5).prop_map(|t| -1.0 + t),
+        (0.0f32..3e-5).prop_map(|t| 1.0 - t),
+        (0u32..64).prop_map(|k| -1.0 + k as f32 * f32::EPSILON),
+        (0u32..64).prop_map(|k| 1.0 - k as f32 * f32::EPSILON / 2.0),
+        -1.0f32..=1.0,
+    ]
+}
+
+proptest! {
+    #![proptest_config(cases(2048))]
+
+    /// The `u16` span path that skips the per-span range check (`Less`,
+    /// writes on, vertex depths clear of the planes: `z_never_clamps` in
+    /// `src/raster.rs`) writes the depths the clamped per-pixel path writes
+    /// (`Always`, which never takes it), for flat triangles with depths
+    /// near both planes and in between. (Debug builds also assert, per
+    /// span, that the unchecked spans stay in range.)
+    #[test]
+    fn unchecked_u16_spans_equal_the_clamped_path(
+        (w, h, pos) in clip_case::<8>(),
+        z in [near_plane_depth(), near_plane_depth(), near_plane_depth()],
+    ) {
+        let mut pos = pos;
+        for (p, z) in pos.iter_mut().zip(z) {
+            p.z = z * p.w;
+        }
+        let n = (w * h) as usize;
+        let depth = |func| {
+            let mut cfg = config_nocull(w, h);
+            cfg.depth_func = func;
+            let mut st = storage(1);
+            let mut frame = Frame::<8>::with_subpixel_bits(cfg, &mut st).unwrap();
+            frame.submit_clip_triangle(pos, [Rgb888::new(9, 8, 7); 3], 0).unwrap();
+            let mut c = vec![Rgb888::new(0, 0, 0); n];
+            let mut z = vec![u16::MAX; n];
+            frame.render_rows(0, h, &mut c[..], &mut z[..]).unwrap();
+            (c, z)
+        };
+        let (less_c, less_z) = depth(DepthFunc::Less);
+        let (all_c, all_z) = depth(DepthFunc::Always);
+        for k in 0..n {
+            // `Less` against the far clear fails only where the depth is
+            // the far plane itself.
+            if all_z[k] != u16::MAX {
+                prop_assert_eq!(less_z[k], all_z[k], "depth at pixel {}", k);
+                prop_assert_eq!(less_c[k], all_c[k], "colour at pixel {}", k);
+            } else {
+                prop_assert_eq!(less_z[k], u16::MAX);
+            }
+        }
+    }
+}
