@@ -1240,3 +1240,75 @@ proptest! {
         }
     }
 }
+
+/// `u16` depth, `u32` depth and the written mask of one flat triangle
+/// under `Less` on far-cleared buffers.
+fn depth_pair<const S: u32>(w: u32, h: u32, pos: [Vec4; 3]) -> (Vec<u16>, Vec<u32>, Vec<bool>) {
+    let n = (w * h) as usize;
+    let mut st = storage(1);
+    let mut frame = Frame::<S>::with_subpixel_bits(config_nocull(w, h), &mut st).unwrap();
+    frame
+        .submit_clip_triangle(pos, [Rgb888::new(9, 8, 7); 3], 0)
+        .unwrap();
+    let (mut c16, mut z16) = (vec![Rgb888::new(0, 0, 0); n], vec![u16::MAX; n]);
+    frame.render_rows(0, h, &mut c16[..], &mut z16[..]).unwrap();
+    let (mut c32, mut z32) = (vec![Rgb888::new(0, 0, 0); n], vec![u32::MAX; n]);
+    frame.render_rows(0, h, &mut c32[..], &mut z32[..]).unwrap();
+    let drawn = Rgb888::new(9, 8, 7);
+    let both = (0..n).map(|k| c16[k] == drawn && c32[k] == drawn).collect();
+    (z16, z32, both)
+}
+
+/// Checks every pixel both buffers wrote: the `u16` word is the `u32`
+/// word's top half, or one off where the `u32` value lies within 2^13
+/// (1/8 of a `u16` LSB, the `u16` path's error bound, plus the `u32`
+/// path's one unit) of the boundary it crosses.
+fn check_depth_pair(z16: &[u16], z32: &[u32], both: &[bool]) -> Result<(), TestCaseError> {
+    for k in 0..z16.len() {
+        if !both[k] {
+            continue;
+        }
+        let (hi, frac) = ((z32[k] >> 16) as i64, z32[k] & 0xffff);
+        let diff = z16[k] as i64 - hi;
+        let ok = diff == 0
+            || (diff == 1 && frac >= (1 << 16) - (1 << 13) - 2)
+            || (diff == -1 && frac <= (1 << 13) + 1);
+        prop_assert!(ok, "pixel {}: u16 {} against u32 {:#x}", k, z16[k], z32[k]);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(cases(2048))]
+
+    /// The `u16` path (`f32` span starts, whole `Z32` steps, the unchecked
+    /// spans of `z_never_clamps`) stays within 1/8 LSB of the `u32` path
+    /// (`f64`, the floor of the exact plane or one off), at both subpixel
+    /// precisions, with depths near both planes and in between. (Moving
+    /// the unchecked spans' start by 9,000 `Z32` units fails it.)
+    #[test]
+    fn u16_depth_within_an_eighth_lsb_of_u32_depth_s8(
+        (w, h, pos) in clip_case::<8>(),
+        z in [near_plane_depth(), near_plane_depth(), near_plane_depth()],
+    ) {
+        let mut pos = pos;
+        for (p, z) in pos.iter_mut().zip(z) {
+            p.z = z * p.w;
+        }
+        let (z16, z32, both) = depth_pair::<8>(w, h, pos);
+        check_depth_pair(&z16, &z32, &both)?;
+    }
+
+    #[test]
+    fn u16_depth_within_an_eighth_lsb_of_u32_depth_s4(
+        (w, h, pos) in clip_case::<4>(),
+        z in [near_plane_depth(), near_plane_depth(), near_plane_depth()],
+    ) {
+        let mut pos = pos;
+        for (p, z) in pos.iter_mut().zip(z) {
+            p.z = z * p.w;
+        }
+        let (z16, z32, both) = depth_pair::<4>(w, h, pos);
+        check_depth_pair(&z16, &z32, &both)?;
+    }
+}
