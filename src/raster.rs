@@ -344,8 +344,6 @@ struct Shader<R, const N: usize> {
     dv: [f32; N],
     dw: f32,
     smooth: bool,
-    /// [`z_never_clamps`] for the triangle's depths and box.
-    unclamped: bool,
 }
 
 /// Interpolants at one pixel: depth, varying numerators, denominator.
@@ -373,7 +371,8 @@ impl<R: Real, const N: usize> Shader<R, N> {
         let smooth = C::SHADED && t.smooth;
         let mut dv = [0.0f32; N];
         let mut dw = 0.0f32;
-        if smooth {
+        // (Unused where every pixel re-synchronises: see `step`.)
+        if smooth && resync(N) > 1 {
             let st = [
                 edges[0].step_x.widen() as f32,
                 edges[1].step_x.widen() as f32,
@@ -395,9 +394,6 @@ impl<R: Real, const N: usize> Shader<R, N> {
             dv,
             dw,
             smooth,
-            unclamped: D::ENABLED
-                && D::FRAC == 0
-                && z_never_clamps(t.z, (t.max_x - t.min_x) as usize),
         }
     }
 
@@ -456,13 +452,16 @@ impl<R: Real, const N: usize> Shader<R, N> {
         a.w = f[0] * t.inv_w[0] + f[1] * t.inv_w[1] + f[2] * t.inv_w[2];
     }
 
-    /// Moves the interpolants one pixel to the right.
+    /// Moves the interpolants one pixel to the right. (Varyings that are
+    /// re-synchronised at every pixel, `resync(N) == 1`, are not stepped:
+    /// the steps would be overwritten unread, and their registers are
+    /// better spent across the fragment shader's call.)
     #[inline(always)]
     fn step<D: DepthBuffer + ?Sized>(&self, a: &mut Acc<R, N>) {
         if D::ENABLED {
             a.z = a.z + self.dz;
         }
-        if self.smooth {
+        if self.smooth && resync(N) > 1 {
             for k in 0..N {
                 a.v[k] += self.dv[k];
             }
@@ -617,53 +616,53 @@ fn draw_in<
         return written;
     }
 
-    if !shader.smooth {
-        // Flat: no varyings to step, so the rows take a loop of their own
-        // with only the depth state live (out of line, its registers are
-        // not the smooth path's).
-        return flat_rows::<N, C, D, R, T>(
-            edges,
-            &shader,
-            row_last - row_first + 1,
-            base,
-            max_n,
-            strip,
-            flat,
-        );
-    }
-    for _ in row_first..=row_last {
-        let mut lo = T::ZERO;
-        let mut hi = T::from_usize(max_n);
-        let covered = edges[0].clip_span(&mut lo, &mut hi)
-            && edges[1].clip_span(&mut lo, &mut hi)
-            && edges[2].clip_span(&mut lo, &mut hi);
-        if covered {
-            let mut e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
-            let mut acc = shader.start::<D, T>(t, e);
-            // Depth exactly as on a flat span (the same Z32.F steps from
-            // the same start), so the written depth never depends on the
-            // pixel type; varyings re-synchronise every `resync(N)` pixels.
-            let mut z = acc.z.to_fixed(D::FRAC);
-            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
-            for n in lo..=hi {
-                if (n - lo).is_multiple_of(resync(N)) && n != lo {
-                    shader.resync(t, e, &mut acc);
+    if shader.smooth {
+        for _ in row_first..=row_last {
+            let mut lo = T::ZERO;
+            let mut hi = T::from_usize(max_n);
+            let covered = edges[0].clip_span(&mut lo, &mut hi)
+                && edges[1].clip_span(&mut lo, &mut hi)
+                && edges[2].clip_span(&mut lo, &mut hi);
+            if covered {
+                let mut e = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
+                let mut acc = shader.start::<D, T>(t, e);
+                // Depth exactly as on a flat span (the same Z32.F steps from
+                // the same start), so the written depth never depends on the
+                // pixel type; varyings re-synchronise every `resync(N)` pixels.
+                let mut z = acc.z.to_fixed(D::FRAC);
+                let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
+                for n in lo..=hi {
+                    if (n - lo).is_multiple_of(resync(N)) && n != lo {
+                        shader.resync(t, e, &mut acc);
+                    }
+                    written +=
+                        shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z, D::FRAC), flat);
+                    z = z.wrapping_add(shader.dz_fixed);
+                    e[0] += edges[0].step_x;
+                    e[1] += edges[1].step_x;
+                    e[2] += edges[2].step_x;
+                    shader.step::<D>(&mut acc);
                 }
-                written +=
-                    shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z, D::FRAC), flat);
-                z = z.wrapping_add(shader.dz_fixed);
-                e[0] += edges[0].step_x;
-                e[1] += edges[1].step_x;
-                e[2] += edges[2].step_x;
-                shader.step::<D>(&mut acc);
             }
+            for edge in edges.iter_mut() {
+                edge.row += edge.step_y;
+            }
+            base += strip.width;
         }
-        for edge in edges.iter_mut() {
-            edge.row += edge.step_y;
-        }
-        base += strip.width;
+        return written;
     }
-    written
+    // Flat: no varyings to step, so the rows take a loop of their own
+    // with only the depth state live (out of line, its registers are
+    // not the smooth path's).
+    flat_rows::<N, C, D, R, T>(
+        edges,
+        &shader,
+        row_last - row_first + 1,
+        (base, t.z),
+        max_n,
+        strip,
+        flat,
+    )
 }
 
 /// The span rows of a flat triangle (one colour, so only depth varies):
@@ -675,14 +674,16 @@ fn flat_rows<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T
     mut edges: [Edge<T>; 3],
     shader: &Shader<R, N>,
     rows: u32,
-    mut base: usize,
+    (mut base, z): (usize, [u32; 3]),
     max_n: usize,
     strip: &mut Strip<'_, C, D>,
     px: C,
 ) -> u32 {
-    if shader.unclamped
+    if D::ENABLED
+        && D::FRAC == 0
         && strip.depth_write
         && matches!(strip.depth_func, DepthFunc::Less | DepthFunc::LessEqual)
+        && z_never_clamps(z, max_n)
     {
         return flat_rows_in_range::<N, C, D, R, T>(edges, shader, rows, base, max_n, strip, px);
     }
