@@ -685,7 +685,12 @@ fn flat_rows<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T
         && matches!(strip.depth_func, DepthFunc::Less | DepthFunc::LessEqual)
         && z_never_clamps(z, max_n)
     {
-        return flat_rows_in_range::<N, C, D, R, T>(edges, shader, rows, base, max_n, strip, px);
+        let args = (edges, shader, rows, base, max_n);
+        return if strip.depth_func == DepthFunc::LessEqual {
+            flat_rows_in_range::<N, C, D, R, T, true>(args, strip, px)
+        } else {
+            flat_rows_in_range::<N, C, D, R, T, false>(args, strip, px)
+        };
     }
     let mut written = 0u32;
     for _ in 0..rows {
@@ -759,16 +764,12 @@ fn flat_rows_in_range<
     D: DepthBuffer + ?Sized,
     R: Real,
     T: EdgeInt,
+    const LE: bool,
 >(
-    mut edges: [Edge<T>; 3],
-    shader: &Shader<R, N>,
-    rows: u32,
-    mut base: usize,
-    max_n: usize,
+    (mut edges, shader, rows, mut base, max_n): ([Edge<T>; 3], &Shader<R, N>, u32, usize, usize),
     strip: &mut Strip<'_, C, D>,
     px: C,
 ) -> u32 {
-    let le = strip.depth_func == DepthFunc::LessEqual;
     let mut written = 0u32;
     for _ in 0..rows {
         let mut lo = T::ZERO;
@@ -785,7 +786,7 @@ fn flat_rows_in_range<
                 hi - lo + 1,
                 z0.round_in_range(),
                 shader.dz_fixed,
-                le,
+                LE,
                 px,
             );
         }
