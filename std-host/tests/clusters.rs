@@ -6,50 +6,21 @@
 
 use microraster::prelude::*;
 use microraster::{
-    BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
-    ProcessedVertex, SetupTriangle, Stats, Vec3,
+    ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors, ProcessedVertex,
+    SetupTriangle, Stats,
 };
+mod common;
+
+use common::{cases, models};
 use microraster_host::cluster::{self, ClusterOptions, ClusteredMesh};
 use proptest::prelude::*;
-use std::sync::OnceLock;
-
-/// `PROPTEST_CASES`, or `default`.
-fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
 
 const W: u32 = 96;
 const H: u32 = 72;
 
-fn model(name: &str) -> ClusteredMesh {
-    let path = format!("{}/../assets/models/{name}", env!("CARGO_MANIFEST_DIR"));
-    let m = microraster_host::obj::load_obj(std::path::Path::new(&path)).unwrap();
-    let p: Vec<Vec3> = m.positions.iter().map(|&a| Vec3::from_array(a)).collect();
-    cluster::build(&p, &m.indices, &ClusterOptions::default()).unwrap()
-}
-
-fn models() -> &'static [ClusteredMesh; 3] {
-    static M: OnceLock<[ClusteredMesh; 3]> = OnceLock::new();
-    M.get_or_init(|| ["stanford-bunny.obj", "teapot.obj", "spot.obj"].map(model))
-}
-
-/// A camera at `dir * dist` bounding radii from the mesh's centre,
-/// looking at a point `jitter` radii off it.
+/// A camera about `m` (see `common::camera`), the far plane at 20 radii.
 fn camera(m: &ClusteredMesh, dir: [f32; 3], dist: f32, jitter: [f32; 3]) -> Option<Mat4> {
-    let b = BoundingSphere::from_points(&m.positions)?;
-    let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if len < 1e-3 {
-        return None;
-    }
-    let eye = b.center + Vec3::from_array(dir.map(|c| c / len)) * (dist * b.radius);
-    let target = b.center + Vec3::from_array(jitter) * b.radius;
-    let view =
-        microraster_host::scene::look_at([eye.x, eye.y, eye.z], [target.x, target.y, target.z])
-            .ok()?;
-    Some(Mat4::perspective(0.9, W as f32 / H as f32, 0.05 * b.radius, 20.0 * b.radius) * view)
+    common::camera(m, dir, dist, jitter, 20.0, W as f32 / H as f32)
 }
 
 /// Colour and depth of the mesh drawn with `cull` (`None`: per triangle).

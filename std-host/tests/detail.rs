@@ -31,44 +31,19 @@ fn within(mvp: &Mat4, centre: Vec3, points: &[[f32; 3]], pixels: u16) -> bool {
             w > 0.0 && (x - cx).abs() < half && (y - cy).abs() < half
         })
 }
-use microraster_host::cluster::{self, ClusterOptions, ClusteredMesh};
-use proptest::prelude::*;
-use std::sync::OnceLock;
+mod common;
 
-fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+use common::{cases, models};
+use microraster_host::cluster::ClusteredMesh;
+use proptest::prelude::*;
 
 const W: u32 = 160;
 const H: u32 = 120;
 
-fn models() -> &'static [ClusteredMesh; 3] {
-    static M: OnceLock<[ClusteredMesh; 3]> = OnceLock::new();
-    M.get_or_init(|| {
-        ["stanford-bunny.obj", "teapot.obj", "spot.obj"].map(|name| {
-            let path = format!("{}/../assets/models/{name}", env!("CARGO_MANIFEST_DIR"));
-            let m = microraster_host::obj::load_obj(std::path::Path::new(&path)).unwrap();
-            let p: Vec<Vec3> = m.positions.iter().map(|&a| Vec3::from_array(a)).collect();
-            cluster::build(&p, &m.indices, &ClusterOptions::default()).unwrap()
-        })
-    })
-}
-
-/// A camera `dist` bounding radii from the centre along `dir`.
+/// A camera `dist` bounding radii from the centre along `dir`, looking at
+/// it, the far plane 2 radii behind the mesh (see `common::camera`).
 fn camera(m: &ClusteredMesh, dir: [f32; 3], dist: f32) -> Option<Mat4> {
-    let b = BoundingSphere::from_points(&m.positions)?;
-    let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-    if len < 1e-3 {
-        return None;
-    }
-    let eye = b.center + Vec3::from_array(dir.map(|c| c / len)) * (dist * b.radius);
-    let c = [b.center.x, b.center.y, b.center.z];
-    let view = microraster_host::scene::look_at([eye.x, eye.y, eye.z], c).ok()?;
-    let near = 0.05 * b.radius;
-    Some(Mat4::perspective(0.9, W as f32 / H as f32, near, (dist + 2.0) * b.radius) * view)
+    common::camera(m, dir, dist, [0.0; 3], dist + 2.0, W as f32 / H as f32)
 }
 
 fn config(cull: CullMode, detail: u16) -> Config {
