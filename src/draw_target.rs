@@ -265,7 +265,7 @@ impl StripDepth for NoDepth {
     fn cleared(&mut self, _: usize, _: u32) -> Option<&mut NoDepth> {
         Some(self)
     }
-    /// The colour in blocks of eight, as [`clear_both`] clears: a loop of
+    /// The colour in blocks of eight, as `clear_both` clears: a loop of
     /// its own, not the `fill` a `NoDepth` span shares (on the Cortex-M4F
     /// the shared, general `fill` made the four-cubes clears 33 k
     /// instructions dearer). The same values as `fill`.
