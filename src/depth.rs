@@ -101,9 +101,9 @@ pub trait DepthBuffer {
     /// `LessEqual` when `le`), writes on, `F = 0`, and a depth the caller
     /// has proved to stay in `[0, 2^32)` over the span: `z0 + n * dz`
     /// (wrapping `u32` sums of `dz`'s low half) is then the exact `Z32`,
-    /// with no clamp. Only
-    /// called for buffers with [`FRAC`](DepthBuffer::FRAC) 0. The
-    /// rasterizer's fast path for `u16` buffers.
+    /// with no clamp. Only called for buffers with
+    /// [`FRAC`](DepthBuffer::FRAC) 0: the rasterizer's fast path for `u16`
+    /// buffers.
     #[doc(hidden)]
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -188,16 +188,7 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
 ) -> u32 {
     let mut written = 0u32;
     if W::FRAC == 0 {
-        let (mut z, dz) = (z0 as u32, dz as u32);
-        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-            let (key, old) = (W::key_in_range(z as u64), (*dp).key());
-            if key < old || (LE && key == old) {
-                *dp = W::from_fixed_in_range(z as u64);
-                *cp = px;
-                written += 1;
-            }
-            z = z.wrapping_add(dz);
-        }
+        written = z32_loop::<W, C, LE>(c, d, z0 as u32, dz as u32, px);
     } else {
         let mut z = z0;
         for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
@@ -218,6 +209,19 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
 /// [`DepthBuffer::flat_span_in_range`] on 32-bit cores.
 #[inline(never)]
 fn span_z32<W: DepthWord, C: Copy, const LE: bool>(
+    c: &mut [C],
+    d: &mut [W],
+    z0: u32,
+    dz: u32,
+    px: C,
+) -> u32 {
+    z32_loop::<W, C, LE>(c, d, z0, dz, px)
+}
+
+/// The `Z32.0` span loop itself, shared by [`span_unclamped`] and
+/// [`span_z32`]: `z` in one `u32`, the word its top half.
+#[inline(always)]
+fn z32_loop<W: DepthWord, C: Copy, const LE: bool>(
     c: &mut [C],
     d: &mut [W],
     z0: u32,
