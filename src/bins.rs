@@ -1,21 +1,31 @@
-//! Binning: which stored triangles reach which strip.
+//! Binning: which stored triangles reach which strip or tile.
 //!
 //! Design note: after a frame's triangles are set up,
-//! [`Frame::bin`](crate::Frame::bin) sorts their indices into one list per strip of
-//! `strip_rows` rows, in caller storage (`offsets`: strips + 1 entries,
-//! `items`: one per (triangle, strip it touches)), with a counting sort
-//! that needs no scratch. Each list keeps submission order, so rendering a
-//! strip from its list gives the same pixels as rendering it from all
-//! triangles. The [`Bins`] remember the frame they were made for (size,
-//! strip height, triangle count), and rendering checks that.
+//! [`Frame::bin`](crate::Frame::bin) sorts their indices into one list per
+//! strip of `strip_rows` rows, and [`Frame::bin_tiles`](crate::Frame::bin_tiles)
+//! into one list per `tile_w x tile_h` tile (numbered row by row from the
+//! top left; a strip is a tile as wide as the frame). The lists live in
+//! caller storage (`offsets`: tiles + 1 entries, `items`: one per
+//! (triangle, tile its box touches)) and are built by a counting sort that
+//! needs no scratch. Each list keeps submission order, so rendering a tile
+//! from its list gives the same pixels as rendering it from all triangles.
+//! The [`Bins`] remember the frame they were made for (size, tile size,
+//! triangle count), and rendering checks that.
 
 use crate::config::{Config, Error};
 use crate::setup::SetupTriangle;
 
-/// Per-strip triangle bins of a frame, made by [`Frame::bin`](crate::Frame::bin).
+/// Per-strip (or per-tile) triangle bins of a frame, made by
+/// [`Frame::bin`](crate::Frame::bin) or
+/// [`Frame::bin_tiles`](crate::Frame::bin_tiles).
 #[derive(Debug)]
 pub struct Bins<'b> {
+    /// Rows per strip or tile.
     pub(crate) strip_rows: u32,
+    /// Columns per tile (the frame width for strips).
+    pub(crate) tile_w: u32,
+    /// Tiles per row of tiles (1 for strips).
+    pub(crate) cols: u32,
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) triangles: usize,
@@ -24,25 +34,56 @@ pub struct Bins<'b> {
 }
 
 impl Bins<'_> {
-    /// Rows per strip.
+    /// Rows per strip (or tile).
     pub fn strip_rows(&self) -> u32 {
         self.strip_rows
     }
 
-    /// The number of strips.
+    /// Columns per tile (the frame width for strips).
+    pub fn tile_width(&self) -> u32 {
+        self.tile_w
+    }
+
+    /// The number of strips (tiles, for
+    /// [`Frame::bin_tiles`](crate::Frame::bin_tiles)).
     pub fn strips(&self) -> u32 {
         self.offsets.len().saturating_sub(1) as u32
     }
 
-    /// The rows `y0..y1` of strip `strip` (the last one possibly shorter;
-    /// empty past the end).
-    pub fn rows(&self, strip: u32) -> (u32, u32) {
-        let y0 = strip.saturating_mul(self.strip_rows).min(self.height);
-        (y0, y0.saturating_add(self.strip_rows).min(self.height))
+    /// The number of tiles (strips, for [`Frame::bin`](crate::Frame::bin)).
+    pub fn tiles(&self) -> u32 {
+        self.strips()
     }
 
-    /// The indices of the stored triangles that reach strip `strip`, in
-    /// submission order (empty past the end).
+    /// The rows `y0..y1` of strip (or tile) `strip` (the last ones possibly
+    /// shorter; empty past the end).
+    pub fn rows(&self, strip: u32) -> (u32, u32) {
+        let [_, _, y0, y1] = self.rect(strip);
+        (y0, y1)
+    }
+
+    /// The rectangle `[x0, x1, y0, y1]` (columns `x0..x1`, rows `y0..y1`)
+    /// of tile (or strip) `tile`. Tiles are numbered row by row from the
+    /// top left; those on the right and bottom sides may be smaller. Empty
+    /// past the end.
+    pub fn rect(&self, tile: u32) -> [u32; 4] {
+        if tile >= self.tiles() {
+            return [0, 0, self.height, self.height];
+        }
+        let cols = self.cols.max(1);
+        let (ty, tx) = (tile / cols, tile % cols);
+        let x0 = tx.saturating_mul(self.tile_w).min(self.width);
+        let y0 = ty.saturating_mul(self.strip_rows).min(self.height);
+        [
+            x0,
+            x0.saturating_add(self.tile_w).min(self.width),
+            y0,
+            y0.saturating_add(self.strip_rows).min(self.height),
+        ]
+    }
+
+    /// The indices of the stored triangles that reach strip (or tile)
+    /// `strip`, in submission order (empty past the end).
     pub fn strip_items(&self, strip: u32) -> &[u32] {
         let s = strip as usize;
         match (self.offsets.get(s), self.offsets.get(s.wrapping_add(1))) {
@@ -56,43 +97,93 @@ impl Bins<'_> {
         self.width == config.width
             && self.height == config.height
             && self.triangles == triangles
-            && self.offsets.len() == self.height.div_ceil(self.strip_rows.max(1)) as usize + 1
+            && tile_count(config, self.tile_w, self.strip_rows) == Some(self.strips() as usize)
+            && self.offsets.len() == self.strips() as usize + 1
     }
 }
 
-/// The strips (of `r` rows) triangle `t` touches.
-#[inline]
-fn strip_range<const N: usize>(t: &SetupTriangle<N>, r: u32) -> core::ops::RangeInclusive<u32> {
-    t.min_y as u32 / r..=t.max_y as u32 / r
+/// Tiles of `tw x th` in a frame: `(per row, rows)`.
+fn grid(config: &Config, tw: u32, th: u32) -> (u32, u32) {
+    (
+        config.width.div_ceil(tw.max(1)),
+        config.height.div_ceil(th.max(1)),
+    )
 }
 
-/// Bin entries for strips of `r >= 1` rows: one per (triangle, strip it
-/// touches); saturates at `usize::MAX` (then no storage can hold them).
-pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], r: u32) -> usize {
-    triangles.iter().fold(0usize, |n, t| {
-        let range = strip_range(t, r);
-        n.saturating_add((range.end() - range.start()) as usize + 1)
+/// The number of tiles of `tw x th` in a frame (`None` on overflow).
+fn tile_count(config: &Config, tw: u32, th: u32) -> Option<usize> {
+    let (c, r) = grid(config, tw, th);
+    (c as usize).checked_mul(r as usize)
+}
+
+/// The tile rows and tile columns (of `tw x th` tiles) triangle `t`'s box
+/// touches.
+#[inline]
+fn tile_range<const N: usize>(
+    t: &SetupTriangle<N>,
+    tw: u32,
+    th: u32,
+) -> (
+    core::ops::RangeInclusive<u32>,
+    core::ops::RangeInclusive<u32>,
+) {
+    (
+        t.min_y as u32 / th..=t.max_y as u32 / th,
+        t.min_x as u32 / tw..=t.max_x as u32 / tw,
+    )
+}
+
+/// The indices of the tiles (`cols` a row) triangle `t`'s box touches.
+fn tiles_of<const N: usize>(
+    t: &SetupTriangle<N>,
+    tw: u32,
+    th: u32,
+    cols: u32,
+) -> impl Iterator<Item = usize> {
+    let (rows, columns) = tile_range(t, tw, th);
+    rows.flat_map(move |r| {
+        columns
+            .clone()
+            .map(move |c| r as usize * cols as usize + c as usize)
     })
 }
 
-/// Sorts `triangles` of a frame of `config` into bins; see
-/// [`Frame::bin`](crate::Frame::bin).
+/// Bin entries for tiles of `tw x th` (0 counts as 1): one per (triangle,
+/// tile its box touches); saturates at `usize::MAX` (then no storage can
+/// hold them).
+pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], tw: u32, th: u32) -> usize {
+    let (tw, th) = (tw.max(1), th.max(1));
+    triangles.iter().fold(0usize, |n, t| {
+        let (rows, cols) = tile_range(t, tw, th);
+        let k = (rows.end() - rows.start()) as usize + 1;
+        n.saturating_add(k.saturating_mul((cols.end() - cols.start()) as usize + 1))
+    })
+}
+
+/// Sorts `triangles` of a frame of `config` into bins of `tile_w x
+/// tile_h` tiles; see [`Frame::bin_tiles`](crate::Frame::bin_tiles). A
+/// tile at least as wide as the frame is a strip.
 pub(crate) fn bin<'b, const N: usize>(
     config: &Config,
     triangles: &[SetupTriangle<N>],
-    strip_rows: u32,
+    (tile_w, tile_h): (u32, u32),
     offsets: &'b mut [u32],
     items: &'b mut [u32],
 ) -> Result<Bins<'b>, Error> {
-    if strip_rows == 0 {
+    if tile_h == 0 {
         return Err(Error::InvalidStripRows);
     }
-    let r = strip_rows;
-    let strips = config.height.div_ceil(r) as usize;
-    let need_items = entries(triangles, r);
-    if offsets.len() < strips + 1 {
+    if tile_w == 0 {
+        return Err(Error::InvalidTileSize);
+    }
+    let (tw, th) = (tile_w.min(config.width.max(1)), tile_h);
+    let cols = grid(config, tw, th).0;
+    let need_items = entries(triangles, tw, th);
+    // At most MAX_DIMENSION^2 tiles: this never overflows a 32-bit usize.
+    let tiles = tile_count(config, tw, th).unwrap_or(usize::MAX);
+    if offsets.len() < tiles.saturating_add(1) {
         return Err(Error::BinStorageSize {
-            expected: strips + 1,
+            expected: tiles.saturating_add(1),
             actual: offsets.len(),
         });
     }
@@ -102,15 +193,15 @@ pub(crate) fn bin<'b, const N: usize>(
             actual: items.len(),
         });
     }
-    let offsets = &mut offsets[..strips + 1];
+    let offsets = &mut offsets[..tiles + 1];
     offsets.fill(0);
     // Count into offsets[s + 1], prefix-sum into starts, fill using
     // offsets[s] as the cursor (it ends at the start of s + 1), then shift
     // back: no scratch beyond the two slices. Every sum is at most
     // `need_items <= u32::MAX`.
     for t in triangles {
-        for s in strip_range(t, r) {
-            if let Some(o) = offsets.get_mut(s as usize + 1) {
+        for s in tiles_of(t, tw, th, cols) {
+            if let Some(o) = offsets.get_mut(s + 1) {
                 *o += 1;
             }
         }
@@ -119,8 +210,8 @@ pub(crate) fn bin<'b, const N: usize>(
         offsets[s] += offsets[s - 1];
     }
     for (i, t) in triangles.iter().enumerate() {
-        for s in strip_range(t, r) {
-            if let Some(o) = offsets.get_mut(s as usize) {
+        for s in tiles_of(t, tw, th, cols) {
+            if let Some(o) = offsets.get_mut(s) {
                 if let Some(slot) = items.get_mut(*o as usize) {
                     *slot = i as u32;
                 }
@@ -133,7 +224,9 @@ pub(crate) fn bin<'b, const N: usize>(
     }
     offsets[0] = 0;
     Ok(Bins {
-        strip_rows: r,
+        strip_rows: th,
+        tile_w: tw,
+        cols,
         width: config.width,
         height: config.height,
         triangles: triangles.len(),

@@ -114,9 +114,20 @@ pub enum Error {
         /// The frame height.
         height: u32,
     },
-    /// The colour slice does not hold exactly the rows asked for.
+    /// The column range is empty, reversed or beyond the frame.
+    InvalidColumns {
+        /// First column asked for.
+        x0: u32,
+        /// One past the last column asked for.
+        x1: u32,
+        /// The frame width.
+        width: u32,
+    },
+    /// [`Frame::bin_tiles`](crate::Frame::bin_tiles) with a tile side of 0.
+    InvalidTileSize,
+    /// The colour slice does not hold exactly the rows (or rectangle) asked for.
     ColorBufferSize {
-        /// `width * (y1 - y0)`.
+        /// `(x1 - x0) * (y1 - y0)` (`x0..x1` the full width for rows).
         expected: usize,
         /// The slice length.
         actual: usize,
@@ -136,9 +147,9 @@ pub enum Error {
         /// The cache length.
         actual: usize,
     },
-    /// The depth slice does not hold exactly the rows asked for.
+    /// The depth slice does not hold exactly the rows (or rectangle) asked for.
     DepthBufferSize {
-        /// `width * (y1 - y0)`.
+        /// `(x1 - x0) * (y1 - y0)` (`x0..x1` the full width for rows).
         expected: usize,
         /// The slice length.
         actual: usize,
@@ -188,6 +199,10 @@ impl core::fmt::Display for Error {
             Error::InvalidRows { y0, y1, height } => {
                 write!(f, "invalid rows {y0}..{y1} for a frame of height {height}")
             }
+            Error::InvalidColumns { x0, x1, width } => {
+                write!(f, "invalid columns {x0}..{x1} for a frame of width {width}")
+            }
+            Error::InvalidTileSize => write!(f, "tiles must be at least 1x1"),
             Error::ColorBufferSize { expected, actual } => {
                 write!(
                     f,
@@ -243,11 +258,25 @@ pub(crate) fn check_rows(
     color_len: usize,
     depth_len: Option<usize>,
 ) -> Result<(), Error> {
+    check_rect(config, [0, config.width, y0, y1], color_len, depth_len)
+}
+
+/// Checks a rectangle `[x0, x1, y0, y1]` (columns `x0..x1`, rows `y0..y1`)
+/// and buffer sizes against a frame.
+pub(crate) fn check_rect(
+    config: &Config,
+    [x0, x1, y0, y1]: [u32; 4],
+    color_len: usize,
+    depth_len: Option<usize>,
+) -> Result<(), Error> {
     let Config { width, height, .. } = *config;
     if y0 >= y1 || y1 > height {
         return Err(Error::InvalidRows { y0, y1, height });
     }
-    let expected = width as usize * (y1 - y0) as usize;
+    if x0 >= x1 || x1 > width {
+        return Err(Error::InvalidColumns { x0, x1, width });
+    }
+    let expected = (x1 - x0) as usize * (y1 - y0) as usize;
     if color_len != expected {
         return Err(Error::ColorBufferSize {
             expected,

@@ -17,7 +17,7 @@
 
 use crate::bins::{self, Bins};
 use crate::color::PixelFormat;
-use crate::config::{check_rows, check_size, Config, Error};
+use crate::config::{check_rect, check_size, Config, Error};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
@@ -155,7 +155,48 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     /// `strip_rows` rows (0 counts as 1): one per (triangle, strip it
     /// touches), saturating at `usize::MAX`.
     pub fn bin_entries(&self, strip_rows: u32) -> usize {
-        bins::entries(self.triangles(), strip_rows.max(1))
+        bins::entries(self.triangles(), self.stage.config.width, strip_rows.max(1))
+    }
+
+    /// The number of bin entries [`Frame::bin_tiles`] needs for tiles of
+    /// `tile_w x tile_h` (0 counts as 1): one per (triangle, tile its box
+    /// touches), saturating at `usize::MAX`.
+    pub fn tile_bin_entries(&self, tile_w: u32, tile_h: u32) -> usize {
+        let w = tile_w.clamp(1, self.stage.config.width);
+        bins::entries(self.triangles(), w, tile_h.max(1))
+    }
+
+    /// The number of tiles of `tile_w x tile_h` (0 counts as 1) in the
+    /// frame: [`Frame::bin_tiles`] needs one more `offsets` entry.
+    pub fn tiles(&self, tile_w: u32, tile_h: u32) -> usize {
+        let c = &self.stage.config;
+        c.width.div_ceil(tile_w.clamp(1, c.width)) as usize
+            * c.height.div_ceil(tile_h.max(1)) as usize
+    }
+
+    /// Sorts the stored triangles into per-tile bins (tiles of `tile_w x
+    /// tile_h >= 1x1` from the top-left corner, numbered row by row; those
+    /// on the right and bottom sides may be smaller; [`Bins::rect`] gives
+    /// each one's rectangle), in caller-provided storage: `offsets` needs
+    /// [`Frame::tiles`]` + 1` entries, `items` [`Frame::tile_bin_entries`].
+    /// Each bin keeps submission order, so [`Frame::render_tile`] gives the
+    /// same pixels as [`Frame::render_rows`] for the tile's rectangle: any
+    /// tile size gives the same frame. A tile as wide as the frame is a
+    /// strip ([`Frame::bin`]).
+    pub fn bin_tiles<'b>(
+        &self,
+        tile_w: u32,
+        tile_h: u32,
+        offsets: &'b mut [u32],
+        items: &'b mut [u32],
+    ) -> Result<Bins<'b>, Error> {
+        bins::bin(
+            &self.stage.config,
+            self.triangles(),
+            (tile_w, tile_h),
+            offsets,
+            items,
+        )
     }
 
     /// Sorts the stored triangles into per-strip bins (strips of
@@ -174,7 +215,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         bins::bin(
             &self.stage.config,
             self.triangles(),
-            strip_rows,
+            (self.stage.config.width, strip_rows),
             offsets,
             items,
         )
@@ -191,19 +232,32 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
     ) -> Result<RenderStats, Error> {
+        self.render_tile_shaded(bins, strip, color, depth, fragment)
+    }
+
+    /// [`Frame::render_tile`] with the fragment shader `fragment` (see
+    /// [`crate::shade`]): the same pixels as [`Frame::render_rect_shaded`]
+    /// for the tile's rectangle.
+    pub fn render_tile_shaded<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
+        &self,
+        bins: &Bins<'_>,
+        tile: u32,
+        color: &mut [C],
+        depth: &mut D,
+        fragment: &F,
+    ) -> Result<RenderStats, Error> {
         if !bins.belong_to(&self.stage.config, self.store.len) {
             return Err(Error::BinsMismatch);
         }
-        let (y0, y1) = bins.rows(strip);
-        check_rows(&self.stage.config, y0, y1, color.len(), depth.depth_len())?;
+        let rect = bins.rect(tile);
+        check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
         let tris = self.triangles();
         Ok(self.draw_each(
-            y0,
-            y1,
+            rect,
             color,
             depth,
             fragment,
-            bins.strip_items(strip)
+            bins.strip_items(tile)
                 .iter()
                 .filter_map(|&i| tris.get(i as usize)),
         ))
@@ -222,15 +276,32 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
     ) -> Result<RenderStats, Error> {
-        check_rows(&self.stage.config, y0, y1, color.len(), depth.depth_len())?;
-        Ok(self.draw_each(y0, y1, color, depth, fragment, self.triangles().iter()))
+        self.render_rect_shaded([0, self.stage.config.width, y0, y1], color, depth, fragment)
     }
 
-    /// Draws `tris` into checked rows.
+    /// Renders the rectangle `[x0, x1, y0, y1]` (columns `x0..x1`, rows
+    /// `y0..y1`) of the frame into `color` and `depth`, which hold exactly
+    /// that rectangle (`(x1 - x0) * (y1 - y0)` values, row `y0` first, each
+    /// row from column `x0`), with the fragment shader `fragment`: the same
+    /// pixels and depths as rendering the whole rows, so any split into
+    /// tiles gives the same frame. [`Error::InvalidColumns`] or
+    /// [`Error::InvalidRows`] for an empty, reversed or out-of-frame
+    /// range; buffer size errors as for [`Frame::render_rows`].
+    pub fn render_rect_shaded<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+        fragment: &F,
+    ) -> Result<RenderStats, Error> {
+        check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
+        Ok(self.draw_each(rect, color, depth, fragment, self.triangles().iter()))
+    }
+
+    /// Draws `tris` into a checked rectangle.
     fn draw_each<'t, C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
-        y0: u32,
-        y1: u32,
+        [x0, x1, y0, y1]: [u32; 4],
         color: &mut [C],
         depth: &mut D,
         fragment: &F,
@@ -238,7 +309,9 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     ) -> RenderStats {
         let c = &self.stage.config;
         let mut strip = Strip {
-            width: c.width as usize,
+            width: (x1 - x0) as usize,
+            x0,
+            x1,
             y0,
             y1,
             color,
@@ -250,7 +323,11 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         for t in tris {
             // Rows outside the strip cost two compares here, not the
             // dispatch and checks of `draw` (which would draw nothing).
-            if (t.max_y as u32) < y0 || (t.min_y as u32) >= y1 {
+            if (t.max_y as u32) < y0
+                || (t.min_y as u32) >= y1
+                || (t.max_x as u32) < x0
+                || (t.min_x as u32) >= x1
+            {
                 continue;
             }
             stats.pixels_written += draw::<S, N, C, D, F>(t, &mut strip, fragment) as u64;
@@ -274,6 +351,34 @@ impl<const S: u32> Frame<'_, S, 3> {
         depth: &mut D,
     ) -> Result<RenderStats, Error> {
         self.render_strip_shaded(bins, strip, color, depth, &VertexColor)
+    }
+
+    /// Renders tile `tile` ([`Bins::rect`]) of a frame binned by
+    /// [`Frame::bin_tiles`] (or strip `tile` of one binned by
+    /// [`Frame::bin`]) into buffers that hold exactly its rectangle, the
+    /// varyings taken as colours ([`VertexColor`]). The same pixels as
+    /// [`Frame::render_rect`] for that rectangle; [`Error::BinsMismatch`]
+    /// as for [`Frame::render_strip`].
+    pub fn render_tile<C: PixelFormat, D: DepthBuffer + ?Sized>(
+        &self,
+        bins: &Bins<'_>,
+        tile: u32,
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<RenderStats, Error> {
+        self.render_tile_shaded(bins, tile, color, depth, &VertexColor)
+    }
+
+    /// Renders the rectangle `[x0, x1, y0, y1]` into buffers that hold
+    /// exactly it (see [`Frame::render_rect_shaded`]), the varyings taken
+    /// as colours ([`VertexColor`]).
+    pub fn render_rect<C: PixelFormat, D: DepthBuffer + ?Sized>(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<RenderStats, Error> {
+        self.render_rect_shaded(rect, color, depth, &VertexColor)
     }
 
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which

@@ -38,7 +38,10 @@
 //!
 //! Set up a frame's triangles once with [`Frame`], then render any rows
 //! `y0..y1` into buffers that hold only those rows, with
-//! [`Frame::render_rows`]. Any split of the frame gives the same pixels.
+//! [`Frame::render_rows`], or any rectangle into buffers that hold only it,
+//! with [`Frame::render_rect`] ([`Frame::bin_tiles`] and
+//! [`Frame::render_tile`] for binned tiles). Any split of the frame into
+//! strips or tiles gives the same pixels and depths.
 //! Where RAM is scarcer than cycles, [`StripRenderer`] draws each submitted
 //! triangle straight into the one strip it holds, and [`StripDrawer`]
 //! pushes strips to any embedded-graphics `DrawTarget`. Triangles and

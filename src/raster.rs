@@ -37,7 +37,13 @@
 //! Runs start where the triangle's geometry says (its box, its exact
 //! spans), never where a strip starts, so the result does not depend on the
 //! strip split (IEEE arithmetic is deterministic, in software on FPU-less
-//! cores too).
+//! cores too). A tile (a window of columns `x0..x1` as well as rows) cuts
+//! runs on the left and right: a triangle whose box crosses a window side
+//! takes `window_rows`, which finds and starts each run as the whole row
+//! does and enters it at the window's first column (depth `z0 + k dz` in
+//! `Z32.F`, varyings from the last re-synchronisation point), so tiles of
+//! any size give the pixels of strips. Triangles inside the window, and
+//! every triangle of a strip, take the paths above unchanged.
 //!
 //! A flat triangle's span rows run in a loop of their own (`flat_rows`),
 //! out of line so that only the depth state is live in it. For a `u16`
@@ -396,7 +402,11 @@ impl<T: EdgeInt> RowSpans<T> {
 
 /// Per-draw state shared by every triangle of one `render_rows` call.
 pub(crate) struct Strip<'b, C, D: ?Sized> {
+    /// Pixels a buffer row holds: `x1 - x0`.
     pub width: usize,
+    /// The window's columns `x0..x1` (`0..frame width` for a strip).
+    pub x0: u32,
+    pub x1: u32,
     pub y0: u32,
     pub y1: u32,
     pub color: &'b mut [C],
@@ -736,9 +746,22 @@ fn draw_in<
     } else {
         C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id)
     };
+    if (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1 {
+        // The box crosses the window's left or right side (tiles only).
+        return window_rows::<N, C, D, F, R, T>(
+            t,
+            edges,
+            &shader,
+            (row_first, row_last),
+            strip,
+            fragment,
+            flat,
+        );
+    }
     let max_n = (t.max_x - t.min_x) as usize;
     let mut written = 0u32;
-    let mut base = (row_first - strip.y0) as usize * strip.width + t.min_x as usize;
+    let mut base =
+        (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
 
     if t.max_x - t.min_x < SMALL_WIDTH {
         // Pixel by pixel over the box: a sign test per pixel.
@@ -831,6 +854,166 @@ fn draw_in<
         strip,
         flat,
     )
+}
+
+/// [`draw_in`] for a triangle whose box crosses the window's left or
+/// right side: every row's run is found and started exactly where the
+/// whole row's is (the same span, the same depth start, the same
+/// varying re-synchronisations), then only its columns inside the window
+/// are drawn. So a tile's pixels and depths are the ones a strip holding
+/// the whole row gets, whatever the tile size. The run is entered at the
+/// window's first column in `O(resync)` steps, not walked from its start:
+/// depth in `Z32.F` is `z0 + k dz` (wrapping, as stepping is), varyings
+/// restart at the last re-synchronisation point before it.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn window_rows<
+    const N: usize,
+    C: PixelFormat,
+    D: DepthBuffer + ?Sized,
+    F: FragmentShader<N>,
+    R: Real,
+    T: EdgeInt,
+>(
+    t: &SetupTriangle<N>,
+    mut edges: [Edge<T>; 3],
+    shader: &Shader<R, N>,
+    (row_first, row_last): (u32, u32),
+    strip: &mut Strip<'_, C, D>,
+    fragment: &F,
+    flat: C,
+) -> u32 {
+    let (min_x, max_n) = (t.min_x as usize, (t.max_x - t.min_x) as usize);
+    let (x0, x1) = (strip.x0 as usize, strip.x1 as usize);
+    if x1 <= min_x || x0 > min_x + max_n {
+        return 0;
+    }
+    // The window's columns as offsets from the box's first column; box
+    // column `n` in `wlo..=whi` is buffer column `min_x + n - x0`.
+    let (wlo, whi) = (x0.saturating_sub(min_x), (x1 - 1 - min_x).min(max_n));
+    let at = |row: usize, n: usize| row + (min_x + n - x0);
+    let mut row = (row_first - strip.y0) as usize * strip.width;
+    let mut written = 0u32;
+    let r = resync(N);
+
+    if max_n < SMALL_WIDTH as usize {
+        // As `draw_in`'s box loop, stepping over columns outside the window.
+        let step = [edges[0].step_x, edges[1].step_x, edges[2].step_x];
+        for _ in row_first..=row_last {
+            let mut e = [edges[0].row, edges[1].row, edges[2].row];
+            let mut n = 0usize;
+            while n <= max_n && (e[0] | e[1] | e[2]) < T::ZERO {
+                e[0] += step[0];
+                e[1] += step[1];
+                e[2] += step[2];
+                n += 1;
+            }
+            if n <= max_n {
+                let mut acc = shader.start::<D, T>(t, e);
+                for k in n..=max_n.min(whi) {
+                    if (e[0] | e[1] | e[2]) < T::ZERO {
+                        break;
+                    }
+                    if r <= SMALL_WIDTH as usize
+                        && shader.smooth
+                        && (k - n).is_multiple_of(r)
+                        && k != n
+                    {
+                        shader.resync(t, e, &mut acc);
+                    }
+                    if k >= wlo {
+                        written += shader.pixel(
+                            t,
+                            strip,
+                            fragment,
+                            at(row, k),
+                            &acc,
+                            acc.z.to_u32(),
+                            flat,
+                        );
+                    }
+                    e[0] += step[0];
+                    e[1] += step[1];
+                    e[2] += step[2];
+                    shader.step::<D>(&mut acc);
+                }
+            }
+            for edge in edges.iter_mut() {
+                edge.row += edge.step_y;
+            }
+            row += strip.width;
+        }
+        return written;
+    }
+
+    let mut spans = RowSpans::new(&edges, max_n);
+    for _ in row_first..=row_last {
+        if let Some((lo, hi)) = spans.span(&edges) {
+            let (lo_n, hi_n) = (lo.widen() as usize, hi.widen() as usize);
+            let (l, h) = (lo_n.max(wlo), hi_n.min(whi));
+            if l <= h {
+                let e_lo = [edges[0].at(lo), edges[1].at(lo), edges[2].at(lo)];
+                if shader.smooth {
+                    let acc0 = shader.start::<D, T>(t, e_lo);
+                    let mut z = acc0
+                        .z
+                        .to_fixed(D::FRAC)
+                        .wrapping_add(((l - lo_n) as i64).wrapping_mul(shader.dz_fixed));
+                    // The last re-synchronisation point at or before `l`.
+                    let p = lo_n + (l - lo_n) / r * r;
+                    let pt = T::from_usize(p);
+                    let mut e = [edges[0].at(pt), edges[1].at(pt), edges[2].at(pt)];
+                    let mut acc = acc0;
+                    if p != lo_n {
+                        shader.resync(t, e, &mut acc);
+                    }
+                    for _ in p..l {
+                        e[0] += edges[0].step_x;
+                        e[1] += edges[1].step_x;
+                        e[2] += edges[2].step_x;
+                        shader.step::<D>(&mut acc);
+                    }
+                    for n in l..=h {
+                        if (n - lo_n).is_multiple_of(r) && n != lo_n && n != p {
+                            shader.resync(t, e, &mut acc);
+                        }
+                        written += shader.pixel(
+                            t,
+                            strip,
+                            fragment,
+                            at(row, n),
+                            &acc,
+                            z32_of(z, D::FRAC),
+                            flat,
+                        );
+                        z = z.wrapping_add(shader.dz_fixed);
+                        e[0] += edges[0].step_x;
+                        e[1] += edges[1].step_x;
+                        e[2] += edges[2].step_x;
+                        shader.step::<D>(&mut acc);
+                    }
+                } else {
+                    let z0 = shader.z_at::<D, T>(e_lo[1], e_lo[2]).to_fixed(D::FRAC);
+                    written += strip.depth.flat_span(
+                        strip.color,
+                        at(row, l),
+                        h - l + 1,
+                        z0.wrapping_add(((l - lo_n) as i64).wrapping_mul(shader.dz_fixed)),
+                        shader.dz_fixed,
+                        strip.depth_func,
+                        strip.depth_write,
+                        flat,
+                    );
+                }
+            }
+        }
+        spans.next();
+        for edge in edges.iter_mut() {
+            edge.row += edge.step_y;
+        }
+        row += strip.width;
+    }
+    written
 }
 
 /// The span rows of a flat triangle (one colour, so only depth varies):

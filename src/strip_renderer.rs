@@ -167,6 +167,8 @@ where
             sink: StripSink {
                 strip: Strip {
                     width: config.width as usize,
+                    x0: 0,
+                    x1: config.width,
                     y0,
                     y1,
                     color,

@@ -396,6 +396,7 @@ mod tests {
             subpixel: 8,
             threads: 1,
             strip_rows: 16,
+            tile_width: 0,
             ids: false,
         }
     }

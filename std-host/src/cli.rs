@@ -213,6 +213,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "R", default_value = "16", value_parser = parse_strip_rows)]
     pub strip_rows: u32,
 
+    /// Draw tiles of WxH pixels (each binned and handed to a thread on its
+    /// own) instead of strips of --strip-rows rows; the image is the same.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "strip_rows")]
+    pub tile: Option<(u32, u32)>,
+
     /// Face culling.
     #[arg(long, value_enum, default_value_t = CullArg::Back)]
     pub cull: CullArg,
@@ -438,6 +443,11 @@ pub struct BenchArgs {
     /// Rows per strip.
     #[arg(long, value_name = "R", default_value = "16", value_parser = parse_strip_rows)]
     pub strip_rows: u32,
+
+    /// Draw tiles of WxH pixels (each binned and handed to a thread on its
+    /// own) instead of strips of --strip-rows rows; the image is the same.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "strip_rows")]
+    pub tile: Option<(u32, u32)>,
 
     /// Face culling.
     #[arg(long, value_enum, default_value_t = CullArg::Back)]

@@ -14,7 +14,10 @@
 //! vertex caches, storages and bins from one call to the next, so a benchmark
 //! loop stops allocating after its first frame; `render::render` uses a fresh
 //! one per image. [`draw_layers`] clears and draws strips on `threads`
-//! workers that take them from one shared queue (inline for one thread).
+//! workers that take them from one shared queue (inline for one thread),
+//! or, binned by tile ([`FramePipeline::with_tile_width`]), tiles drawn
+//! into each worker's own tile buffers and copied into the image
+//! ([`for_each_tile`]).
 //! Every strip draws the frames in order and the core draws triangles in
 //! submission order, so the image is byte-identical for any thread count and
 //! any strip height.
@@ -221,34 +224,179 @@ where
     Ok(total)
 }
 
+/// One tile for [`for_each_tile`]: its index, its rectangle `[x0, x1, y0,
+/// y1]`, and the rows of the image it lies in (colour, depth).
+type TileWork<'a, C, T> = (u32, &'a Band<'a, C, T>);
+
+/// A band of whole image rows (colour, depth) that tiles are copied into.
+type Band<'a, C, T> = Mutex<(&'a mut [C], Option<&'a mut [T]>)>;
+
+/// Calls `f(tile, [x0, x1, y0, y1], colour, depth)` for every tile of
+/// `tile_w x tile_h` (numbered row by row, as [`Frame::bin_tiles`] does) of
+/// an image `width` pixels wide, with buffers that hold exactly the tile,
+/// on `threads` workers taking tiles from a shared queue, and sums what it
+/// returns. Tiles at least as wide as the image are strips, handed out as
+/// the image's own rows ([`for_each_strip`]); narrower ones are drawn into
+/// each worker's own tile buffers (which `f` must clear or draw over: they
+/// hold the image's pixels only when `copy_in`), then copied into the
+/// image.
+#[allow(clippy::too_many_arguments)]
+pub fn for_each_tile<C, T, F>(
+    color: &mut [C],
+    depth: Option<&mut [T]>,
+    width: usize,
+    (tile_w, tile_h): (usize, usize),
+    threads: usize,
+    copy_in: bool,
+    f: F,
+) -> Result<u64, Error>
+where
+    C: Send + Copy,
+    T: Send + Copy,
+    F: Fn(u32, [u32; 4], &mut [C], Option<&mut [T]>) -> Result<u64, Error> + Sync,
+{
+    let th = tile_h.max(1);
+    if tile_w == 0 || tile_w >= width || width == 0 {
+        return for_each_strip(color, depth, width, th, threads, |y0, c, d| {
+            let y1 = y0 + (c.len() / width.max(1)) as u32;
+            f(y0 / th as u32, [0, width as u32, y0, y1], c, d)
+        });
+    }
+    let tw = tile_w;
+    let cols = width.div_ceil(tw);
+    let chunk = width * th;
+    let bands: Vec<Band<'_, C, T>> = match depth {
+        Some(d) => color
+            .chunks_mut(chunk)
+            .zip(d.chunks_mut(chunk))
+            .map(|(c, d)| Mutex::new((c, Some(d))))
+            .collect(),
+        None => color
+            .chunks_mut(chunk)
+            .map(|c| Mutex::new((c, None)))
+            .collect(),
+    };
+    let work: Vec<TileWork<'_, C, T>> = bands
+        .iter()
+        .enumerate()
+        .flat_map(|(b, m)| (0..cols).map(move |k| ((b * cols + k) as u32, m)))
+        .collect();
+    // Draws one tile into the worker's buffers and copies it out.
+    let one = |(tile, band): TileWork<'_, C, T>,
+               lc: &mut Vec<C>,
+               ld: &mut Vec<T>|
+     -> Result<u64, Error> {
+        let (ty, tx) = (tile as usize / cols, tile as usize % cols);
+        // Any value sizes the buffers (`f` or the copy-in sets every one):
+        // the band's first.
+        let (rows, c0, d0) = {
+            let g = lock(band);
+            (g.0.len() / width, g.0[0], g.1.as_deref().map(|d| d[0]))
+        };
+        let (x0, x1) = (tx * tw, (tx * tw + tw).min(width));
+        let (y0, y1) = (ty * th, ty * th + rows);
+        let (w, n) = (x1 - x0, (x1 - x0) * rows);
+        lc.resize(n, c0);
+        let has_depth = d0.is_some();
+        if let Some(d0) = d0 {
+            ld.resize(n, d0);
+        }
+        if copy_in {
+            let mut g = lock(band);
+            let (c, d) = &mut *g;
+            for r in 0..rows {
+                lc[r * w..r * w + w].copy_from_slice(&c[r * width + x0..r * width + x1]);
+                if let Some(d) = d.as_deref() {
+                    ld[r * w..r * w + w].copy_from_slice(&d[r * width + x0..r * width + x1]);
+                }
+            }
+        }
+        let rect = [x0 as u32, x1 as u32, y0 as u32, y1 as u32];
+        let px = f(tile, rect, &mut lc[..n], has_depth.then_some(&mut ld[..n]))?;
+        let mut g = lock(band);
+        let (c, d) = &mut *g;
+        for r in 0..rows {
+            c[r * width + x0..r * width + x1].copy_from_slice(&lc[r * w..r * w + w]);
+            if let Some(d) = d.as_deref_mut() {
+                d[r * width + x0..r * width + x1].copy_from_slice(&ld[r * w..r * w + w]);
+            }
+        }
+        Ok(px)
+    };
+    if threads <= 1 {
+        let (mut lc, mut ld) = (Vec::new(), Vec::new());
+        let mut total = 0;
+        for item in work {
+            total += one(item, &mut lc, &mut ld)?;
+        }
+        return Ok(total);
+    }
+    let queue = Mutex::new(work.into_iter());
+    let results: Vec<Result<u64, Error>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                s.spawn(|| -> Result<u64, Error> {
+                    let (mut lc, mut ld) = (Vec::new(), Vec::new());
+                    let mut total = 0;
+                    loop {
+                        let item = match queue.lock() {
+                            Ok(mut q) => q.next(),
+                            Err(poisoned) => poisoned.into_inner().next(),
+                        };
+                        let Some(item) = item else { break };
+                        total += one(item, &mut lc, &mut ld)?;
+                    }
+                    Ok(total)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or(Ok(0)))
+            .collect()
+    });
+    let mut total = 0;
+    for r in results {
+        total += r?;
+    }
+    Ok(total)
+}
+
+/// Locks `m`, whether or not another worker panicked holding it.
+fn lock<X>(m: &Mutex<X>) -> std::sync::MutexGuard<'_, X> {
+    match m.lock() {
+        Ok(g) => g,
+        Err(poisoned) => poisoned.into_inner(),
+    }
+}
+
 /// A set-up, binned frame: the part of the scene one setup worker built.
 pub type Layer<'a, 'f, const S: u32> = (&'a Frame<'f, S>, &'a Bins<'a>);
 
-/// Draws every strip of the binned frames `layers` (in order, binned into
-/// strips of `rows` rows) on `threads` workers, clearing each strip first
-/// (colour to `clear`, depth to [`DepthWord::FAR`]) if `clear` is given.
-/// Returns the pixels written.
+/// Draws every strip or tile of the binned frames `layers` (in order; all
+/// binned alike, by [`Frame::bin`] or [`Frame::bin_tiles`]) on `threads`
+/// workers, clearing each first (colour to `clear`, depth to
+/// [`DepthWord::FAR`]) if `clear` is given. Returns the pixels written.
 pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
     layers: &[Layer<'_, '_, S>],
     color: &mut [C],
     depth: Option<&mut [T]>,
-    rows: u32,
     threads: usize,
     clear: Option<C>,
 ) -> Result<u64, Error> {
-    let Some((first, _)) = layers.first() else {
+    let Some((first, bins)) = layers.first() else {
         return Ok(0);
     };
     let width = first.config().width as usize;
-    let rows = rows.max(1);
-    for_each_strip(
+    let tile = (bins.tile_width() as usize, bins.strip_rows() as usize);
+    for_each_tile(
         color,
         depth,
         width,
-        rows as usize,
+        tile,
         threads,
-        |y0, c, mut d| {
-            let strip = y0 / rows;
+        clear.is_none(),
+        |tile, _, c, mut d| {
             if let Some(v) = clear {
                 c.fill(v);
                 if let Some(d) = d.as_deref_mut() {
@@ -258,10 +406,10 @@ pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
             let mut written = 0;
             for (frame, bins) in layers {
                 written += match d.as_deref_mut() {
-                    Some(d) => frame.render_strip(bins, strip, c, d)?.pixels_written,
+                    Some(d) => frame.render_tile(bins, tile, c, d)?.pixels_written,
                     None => {
                         frame
-                            .render_strip(bins, strip, c, &mut NoDepth)?
+                            .render_tile(bins, tile, c, &mut NoDepth)?
                             .pixels_written
                     }
                 };
@@ -300,13 +448,15 @@ impl SetupTimes {
 /// each visible object in parallel chunks, the triangle stage in `threads`
 /// contiguous chunks of the scene (one below
 /// [`PARALLEL_SETUP_MIN_TRIANGLES`] triangles), each into its own frame and
-/// setup storage, each frame binned by strip, and the strips drawn on
-/// `threads` workers, every strip drawing the frames in order.
+/// setup storage, each frame binned by strip (or tile), and the strips
+/// drawn on `threads` workers, every strip drawing the frames in order.
 #[derive(Debug)]
 pub struct FramePipeline<const S: u32> {
     config: Config,
     threads: usize,
     strip_rows: u32,
+    /// Tile width; 0 for strips.
+    tile_w: u32,
     caches: Vec<Vec<ProcessedVertex>>,
     storages: Vec<Vec<SetupTriangle>>,
     bins: Vec<(Vec<u32>, Vec<u32>)>,
@@ -411,6 +561,7 @@ impl<const S: u32> FramePipeline<S> {
             config,
             threads: threads.max(1),
             strip_rows: strip_rows.max(1),
+            tile_w: 0,
             caches: Vec::new(),
             storages: Vec::new(),
             bins: Vec::new(),
@@ -432,6 +583,23 @@ impl<const S: u32> FramePipeline<S> {
         self.strip_rows
     }
 
+    /// Bins into tiles `tile_w` pixels wide (and [`strip_rows`](Self::strip_rows)
+    /// high) instead of strips: `0`, or the frame width and more, are
+    /// strips. The image is the same either way.
+    pub fn with_tile_width(mut self, tile_w: u32) -> Self {
+        self.tile_w = if tile_w >= self.config.width {
+            0
+        } else {
+            tile_w
+        };
+        self
+    }
+
+    /// The tile width (0: strips).
+    pub fn tile_width(&self) -> u32 {
+        self.tile_w
+    }
+
     /// Sets `scene` up (vertex stage, triangle stage, binning) and hands
     /// the binned frames to `then`.
     pub fn with_layers<R>(
@@ -443,11 +611,14 @@ impl<const S: u32> FramePipeline<S> {
             config,
             threads,
             strip_rows,
+            tile_w,
             caches,
             storages,
             bins,
         } = self;
         let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
+        // Strips are tiles as wide as the frame.
+        let tile_w = if *tile_w == 0 { config.width } else { *tile_w };
         let t0 = Instant::now();
         let caches = vertex_stage::<S>(config, threads, scene, caches)?;
         let caches = &caches[..];
@@ -497,13 +668,13 @@ impl<const S: u32> FramePipeline<S> {
 
         // Binning.
         let t2 = Instant::now();
-        let strips = config.height.div_ceil(strip_rows) as usize;
         bins.resize_with(frames.len(), Default::default);
         for (f, (offsets, items)) in frames.iter().zip(bins.iter_mut()) {
-            if offsets.len() < strips + 1 {
-                offsets.resize(strips + 1, 0);
+            let tiles = f.tiles(tile_w, strip_rows);
+            if offsets.len() < tiles + 1 {
+                offsets.resize(tiles + 1, 0);
             }
-            let need = f.bin_entries(strip_rows);
+            let need = f.tile_bin_entries(tile_w, strip_rows);
             if items.len() < need {
                 items.resize(need, 0);
             }
@@ -514,7 +685,7 @@ impl<const S: u32> FramePipeline<S> {
                 let handles: Vec<_> = frames
                     .iter()
                     .zip(bins.iter_mut())
-                    .map(|(f, (o, i))| s.spawn(move || f.bin(strip_rows, o, i)))
+                    .map(|(f, (o, i))| s.spawn(move || f.bin_tiles(tile_w, strip_rows, o, i)))
                     .collect();
                 handles
                     .into_iter()
@@ -529,7 +700,7 @@ impl<const S: u32> FramePipeline<S> {
             frames
                 .iter()
                 .zip(bins.iter_mut())
-                .map(|(f, (o, i))| f.bin(strip_rows, o, i))
+                .map(|(f, (o, i))| f.bin_tiles(tile_w, strip_rows, o, i))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| e.to_string())?
         };
@@ -561,10 +732,10 @@ impl<const S: u32> FramePipeline<S> {
         depth: Option<&mut [T]>,
         clear: C,
     ) -> Result<(SetupTimes, f64, u64), String> {
-        let (threads, rows) = (self.threads, self.strip_rows);
+        let threads = self.threads;
         let ((raster_ms, px), setup) = self.with_layers(scene, |layers| {
             let t = Instant::now();
-            let px = draw_layers(layers, color, depth, rows, threads, Some(clear))
+            let px = draw_layers(layers, color, depth, threads, Some(clear))
                 .map_err(|e| e.to_string())?;
             Ok((ms(t), px))
         })?;

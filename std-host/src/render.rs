@@ -50,8 +50,11 @@ pub struct RenderOptions {
     pub subpixel: u32,
     /// Worker threads (at least 1).
     pub threads: usize,
-    /// Rows per strip (at least 1).
+    /// Rows per strip (at least 1), or per tile.
     pub strip_rows: u32,
+    /// Draw tiles this many pixels wide and `strip_rows` high instead of
+    /// strips (0, or the width and more: strips). The image is the same.
+    pub tile_width: u32,
     /// Also render the triangle-id image.
     pub ids: bool,
 }
@@ -193,19 +196,18 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
     let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
     let len = w as usize * h as usize;
     let t0 = Instant::now();
-    let mut pipe = FramePipeline::<S>::new(config, threads, rows);
+    let mut pipe = FramePipeline::<S>::new(config, threads, rows).with_tile_width(opts.tile_width);
     let ((color, depth, pixels_written, ids, timings), setup) =
         pipe.with_layers(scene, |layers| {
             let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
             let mut color = vec![BACKGROUND; len];
             let t1 = Instant::now();
-            let (depth, px) =
-                draw_image(layers, &mut color, opts.depth, BACKGROUND, rows, threads)?;
+            let (depth, px) = draw_image(layers, &mut color, opts.depth, BACKGROUND, threads)?;
             let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
             let t2 = Instant::now();
             let ids = if opts.ids {
                 let mut ids = vec![TriangleId(0); len];
-                draw_image(layers, &mut ids, opts.depth, TriangleId(0), rows, threads)?;
+                draw_image(layers, &mut ids, opts.depth, TriangleId(0), threads)?;
                 Some(ids.into_iter().map(|t| t.0).collect())
             } else {
                 None
@@ -239,23 +241,22 @@ fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
     color: &mut [C],
     kind: DepthKind,
     clear: C,
-    rows: u32,
     threads: usize,
 ) -> Result<(DepthImage, u64), String> {
     let len = color.len();
     let (depth, px) = match kind {
         DepthKind::U16 => {
             let mut d = vec![u16::MAX; len];
-            let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
+            let px = draw_layers(layers, color, Some(&mut d[..]), threads, Some(clear));
             (DepthImage::U16(d), px)
         }
         DepthKind::U32 => {
             let mut d = vec![u32::MAX; len];
-            let px = draw_layers(layers, color, Some(&mut d[..]), rows, threads, Some(clear));
+            let px = draw_layers(layers, color, Some(&mut d[..]), threads, Some(clear));
             (DepthImage::U32(d), px)
         }
         DepthKind::None => {
-            let px = draw_layers::<S, C, u32>(layers, color, None, rows, threads, Some(clear));
+            let px = draw_layers::<S, C, u32>(layers, color, None, threads, Some(clear));
             (DepthImage::None, px)
         }
     };
@@ -277,6 +278,7 @@ mod tests {
             subpixel: 8,
             threads,
             strip_rows,
+            tile_width: 0,
             ids: true,
         }
     }

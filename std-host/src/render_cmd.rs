@@ -41,8 +41,10 @@ pub struct RenderStats {
     pub height: u32,
     /// Worker threads.
     pub threads: usize,
-    /// Rows per strip.
+    /// Rows per strip (or tile).
     pub strip_rows: u32,
+    /// Tile width, or `null` for strips.
+    pub tile_width: Option<u32>,
     /// Sub-pixel bits.
     pub subpixel_bits: u32,
     /// FNV-1a of the RGB8 bytes, as `--checksum` prints it.
@@ -375,7 +377,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         },
         subpixel: args.subpixel,
         threads: args.threads,
-        strip_rows: args.strip_rows,
+        strip_rows: args.tile.map_or(args.strip_rows, |t| t.1),
+        tile_width: args.tile.map_or(0, |t| t.0),
         ids: args.id_out.is_some(),
     };
     let (r, load_warnings) = match args.source() {
@@ -435,6 +438,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             height: r.height,
             threads: opts.threads,
             strip_rows: opts.strip_rows,
+            tile_width: (opts.tile_width > 0 && opts.tile_width < r.width)
+                .then_some(opts.tile_width),
             subpixel_bits: opts.subpixel,
             checksum,
             counters: RenderCounters {

@@ -26,7 +26,7 @@
 //! shared queue, as in [`crate::render`]; the image is identical for any
 //! thread count and strip height.
 
-use crate::pipeline::for_each_strip;
+use crate::pipeline::for_each_tile;
 use crate::render::{DepthImage, DepthKind, RenderOptions, Rendered, Timings, BACKGROUND};
 use crate::scene::{look_at, up_for};
 use microraster::math::radians;
@@ -353,10 +353,11 @@ impl Job<'_> {
         let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
         let len = w as usize * h as usize;
         let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
+        let tile = (opts.tile_width, rows);
         let t1 = Instant::now();
         let mut color = vec![BACKGROUND; len];
         let (depth, pixels_written) = draw(
-            &frame, &mut color, opts.depth, BACKGROUND, rows, threads, fragment,
+            &frame, &mut color, opts.depth, BACKGROUND, tile, threads, fragment,
         )?;
         let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
         let t2 = Instant::now();
@@ -367,7 +368,7 @@ impl Job<'_> {
                 &mut ids,
                 opts.depth,
                 TriangleId(0),
-                rows,
+                tile,
                 threads,
                 fragment,
             )?;
@@ -401,7 +402,7 @@ fn draw<const S: u32, const N: usize, C, F>(
     color: &mut [C],
     kind: DepthKind,
     clear: C,
-    rows: u32,
+    (tile_w, rows): (u32, u32),
     threads: usize,
     fragment: &F,
 ) -> Result<(DepthImage, u64), String>
@@ -418,7 +419,7 @@ where
                 color,
                 Some(&mut d[..]),
                 clear,
-                rows,
+                (tile_w, rows),
                 threads,
                 fragment,
             )?;
@@ -431,15 +432,22 @@ where
                 color,
                 Some(&mut d[..]),
                 clear,
-                rows,
+                (tile_w, rows),
                 threads,
                 fragment,
             )?;
             (DepthImage::U32(d), px)
         }
         DepthKind::None => {
-            let px =
-                draw_with::<S, N, C, F, u32>(frame, color, None, clear, rows, threads, fragment)?;
+            let px = draw_with::<S, N, C, F, u32>(
+                frame,
+                color,
+                None,
+                clear,
+                (tile_w, rows),
+                threads,
+                fragment,
+            )?;
             (DepthImage::None, px)
         }
     })
@@ -451,7 +459,7 @@ fn draw_with<const S: u32, const N: usize, C, F, T>(
     color: &mut [C],
     depth: Option<&mut [T]>,
     clear: C,
-    rows: u32,
+    (tile_w, rows): (u32, u32),
     threads: usize,
     fragment: &F,
 ) -> Result<u64, String>
@@ -461,19 +469,19 @@ where
     T: DepthWord,
 {
     let width = frame.config().width as usize;
-    let strip = |y0: u32, c: &mut [C], d: Option<&mut [T]>| -> Result<u64, Error> {
+    let tile = (tile_w as usize, rows as usize);
+    let draw_tile = |_, rect: [u32; 4], c: &mut [C], d: Option<&mut [T]>| -> Result<u64, Error> {
         c.fill(clear);
-        let y1 = y0 + (c.len() / width) as u32;
         Ok(match d {
             Some(d) => {
                 d.fill(T::FAR);
-                frame.render_rows_shaded(y0, y1, c, d, fragment)?
+                frame.render_rect_shaded(rect, c, d, fragment)?
             }
-            None => frame.render_rows_shaded(y0, y1, c, &mut NoDepth, fragment)?,
+            None => frame.render_rect_shaded(rect, c, &mut NoDepth, fragment)?,
         }
         .pixels_written)
     };
-    for_each_strip(color, depth, width, rows as usize, threads, strip).map_err(|e| e.to_string())
+    for_each_tile(color, depth, width, tile, threads, false, draw_tile).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -522,6 +530,7 @@ mod tests {
             subpixel: 8,
             threads,
             strip_rows,
+            tile_width: 0,
             ids: true,
         }
     }

@@ -105,6 +105,69 @@ fn output_is_identical_for_any_threads_and_strip_rows() {
     }
 }
 
+/// The colour, id and depth outputs of `render` with `extra` arguments.
+fn outputs(tag: &str, extra: &[&str]) -> [Vec<u8>; 3] {
+    let (img, ids, depth) = (
+        tmp(&format!("{tag}.png")),
+        tmp(&format!("{tag}-ids.png")),
+        tmp(&format!("{tag}-depth.raw")),
+    );
+    let mut args = vec![
+        "render",
+        "--out",
+        img.to_str().unwrap(),
+        "--id-out",
+        ids.to_str().unwrap(),
+        "--depth-out",
+        depth.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    [img, ids, depth].map(|p| std::fs::read(p).unwrap())
+}
+
+/// `--tile WxH` draws tiles instead of strips: the same image, ids and
+/// depth, for the built-in scenes and a lit, textured model, at any tile
+/// size and thread count.
+#[test]
+fn tiles_give_the_output_of_strips() {
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
+    for (name, scene) in [
+        ("cubes", vec!["--size", "203x150"]),
+        ("spot", vec!["--obj", spot, "--size", "160x120"]),
+    ] {
+        for depth in ["u16", "u32"] {
+            let mut base_args = scene.clone();
+            base_args.extend(["--depth", depth]);
+            let mut one = base_args.clone();
+            one.extend(["--threads", "1"]);
+            let base = outputs(&format!("tiles-{name}-{depth}"), &one);
+            for (t, tile) in [("1", "32x32"), ("2", "7x5"), ("3", "64x16"), ("2", "1x200")] {
+                let mut a = base_args.clone();
+                a.extend(["--threads", t, "--tile", tile]);
+                let tag = format!("tiles-{name}-{depth}-{t}-{}", tile.replace('x', "_"));
+                assert!(
+                    outputs(&tag, &a) == base,
+                    "{name}: depth {depth}, {t} threads, tiles {tile}"
+                );
+            }
+        }
+    }
+    for bad in [
+        &["--tile", "32x32", "--strip-rows", "8"][..],
+        &["--tile", "0x32"],
+    ] {
+        let mut a = vec!["render"];
+        a.extend_from_slice(bad);
+        let o = run(&a);
+        assert!(
+            !o.status.success() && stderr(&o).contains("--tile"),
+            "{bad:?}"
+        );
+    }
+}
+
 #[test]
 fn id_and_depth_outputs_have_the_right_size() {
     let (img, ids, depth) = (tmp("i.png"), tmp("ids.png"), tmp("depth.raw"));

@@ -177,6 +177,7 @@ fn a_clustered_scene_renders_the_same_image_on_threads() {
         subpixel: 8,
         threads,
         strip_rows: 16,
+        tile_width: 0,
         ids: false,
     };
     let want = render(&plain, &ro(1)).unwrap();

@@ -81,8 +81,10 @@ pub struct Settings {
     pub height: u32,
     /// Thread counts, one run each (the first is the headline run).
     pub threads: Vec<usize>,
-    /// Rows per strip.
+    /// Rows per strip (or tile).
     pub strip_rows: u32,
+    /// Tile width (0: strips).
+    pub tile_width: u32,
     /// Face culling.
     pub cull: CullMode,
     /// Detail culling in pixels (0: off).
@@ -128,7 +130,8 @@ pub fn settings(args: &BenchArgs, name: Option<&str>) -> Settings {
         width: w,
         height: h,
         threads,
-        strip_rows: args.strip_rows,
+        strip_rows: args.tile.map_or(args.strip_rows, |t| t.1),
+        tile_width: args.tile.map_or(0, |t| t.0),
         cull: match args.cull {
             CullArg::Back => CullMode::Back,
             CullArg::Front => CullMode::Front,
@@ -301,6 +304,7 @@ pub fn bench(bs: &mut BenchScene, s: &Settings) -> Result<Report, String> {
         cull: cull_name(s.cull),
         subpixel_bits: s.subpixel,
         strip_rows: s.strip_rows,
+        tile_width: s.tile_width,
         spin_deg_per_frame: s.spin,
         frames: s.frames,
         warmup: s.warmup,
@@ -347,6 +351,7 @@ struct BenchJson<'a> {
     cull: &'static str,
     subpixel_bits: u32,
     strip_rows: u32,
+    tile_width: u32,
     spin_deg_per_frame: f32,
     frames: u32,
     warmup: u32,
@@ -563,6 +568,7 @@ mod tests {
                 subpixel: 8,
                 threads: 1,
                 strip_rows: 16,
+                tile_width: 0,
                 ids: false,
             };
             let want = render::render(&bs.scene, &opts).unwrap();

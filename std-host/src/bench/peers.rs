@@ -483,6 +483,7 @@ mod tests {
             subpixel: 8,
             threads: 1,
             strip_rows: 16,
+            tile_width: 0,
             ids: false,
         }
     }

@@ -286,7 +286,8 @@ pub fn run_frames<const S: u32, C: BenchColor, T: DepthWord>(
     what: &str,
     progress: &mut Progress,
 ) -> Result<Run, String> {
-    let mut pipe = FramePipeline::<S>::new(config_of(s), threads, s.strip_rows);
+    let mut pipe =
+        FramePipeline::<S>::new(config_of(s), threads, s.strip_rows).with_tile_width(s.tile_width);
     let len = s.width as usize * s.height as usize;
     let mut color = vec![C::CLEAR; len];
     let mut depth = vec![T::FAR; if depth_on { len } else { 0 }];
@@ -355,6 +356,7 @@ fn render_fn_section(
         subpixel: s.subpixel,
         threads,
         strip_rows: s.strip_rows,
+        tile_width: s.tile_width,
         ids: false,
     };
     let (mut total, mut setup, mut raster) = (Vec::new(), Vec::new(), Vec::new());

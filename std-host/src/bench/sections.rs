@@ -29,7 +29,7 @@ pub fn split<const S: u32, C: BenchColor, T: DepthWord>(
     let warm = s.warmup.min(2);
     let len = s.width as usize * s.height as usize;
     let rows = s.strip_rows;
-    let mut pipe = FramePipeline::<S>::new(config_of(s), 1, rows);
+    let mut pipe = FramePipeline::<S>::new(config_of(s), 1, rows).with_tile_width(s.tile_width);
 
     // The transform alone, every vertex once.
     let mut out: Vec<Vec4> = Vec::new();
@@ -84,20 +84,14 @@ pub fn split<const S: u32, C: BenchColor, T: DepthWord>(
         let mut c = Vec::new();
         for k in 0..warm + iters {
             let t = Instant::now();
-            px[0] = draw_layers::<S, TriangleId, T>(layers, &mut ids, None, rows, 1, None)
-                .map_err(err)?;
+            px[0] =
+                draw_layers::<S, TriangleId, T>(layers, &mut ids, None, 1, None).map_err(err)?;
             let ta = ms(t);
             ids_depth.fill(T::FAR);
             let t = Instant::now();
-            px[1] = draw_layers::<S, TriangleId, T>(
-                layers,
-                &mut ids,
-                Some(&mut ids_depth),
-                rows,
-                1,
-                None,
-            )
-            .map_err(err)?;
+            px[1] =
+                draw_layers::<S, TriangleId, T>(layers, &mut ids, Some(&mut ids_depth), 1, None)
+                    .map_err(err)?;
             let tb = ms(t);
             depth.fill(T::FAR);
             let t = Instant::now();
@@ -105,7 +99,6 @@ pub fn split<const S: u32, C: BenchColor, T: DepthWord>(
                 layers,
                 &mut color,
                 depth_on.then_some(&mut depth[..]),
-                rows,
                 1,
                 None,
             )
@@ -233,7 +226,8 @@ pub fn floor<const S: u32, C: BenchColor, T: DepthWord>(
         black_box(&depth);
         Ok(())
     })?;
-    let mut pipe = FramePipeline::<S>::new(config_of(s), threads, rows);
+    let mut pipe =
+        FramePipeline::<S>::new(config_of(s), threads, rows).with_tile_width(s.tile_width);
     let (draw_only, _) = pipe.with_layers(scene, |layers| {
         let mut v = Vec::new();
         for k in 0..s.warmup + s.frames {
@@ -244,7 +238,6 @@ pub fn floor<const S: u32, C: BenchColor, T: DepthWord>(
                 layers,
                 &mut color,
                 depth_on.then_some(&mut depth[..]),
-                rows,
                 threads,
                 None,
             )
