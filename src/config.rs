@@ -31,6 +31,24 @@ pub enum FrontFace {
     Cw,
 }
 
+/// How triangles become pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RasterMode {
+    /// Clip against near, far and the guard band in homogeneous space,
+    /// divide by `w`, snap to `Sub<S>` and rasterize the snapped triangle
+    /// (the default).
+    #[default]
+    Clipping,
+    /// Olano and Greer's 2D-homogeneous rasterization
+    /// ([`crate::clipless`]): no clipping and no division by `w`; edge
+    /// functions are cross products of quantized homogeneous vertices,
+    /// near and far are tested exactly per row. Only
+    /// [`StripRenderer`](crate::StripRenderer) draws in this mode
+    /// ([`Frame`](crate::Frame) refuses it with
+    /// [`Error::ModeUnsupported`]).
+    Clipless,
+}
+
 /// Per-frame settings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Config {
@@ -55,6 +73,8 @@ pub struct Config {
     /// [`Detail`](crate::Detail)). Small objects vanish, and small clusters
     /// of a surface leave holes of about that size.
     pub detail: u16,
+    /// Clipping (the default) or clipless rasterization.
+    pub mode: RasterMode,
 }
 
 impl Config {
@@ -69,6 +89,7 @@ impl Config {
             depth_func: DepthFunc::Less,
             depth_write: true,
             detail: 0,
+            mode: RasterMode::Clipping,
         }
     }
 }
@@ -172,6 +193,10 @@ pub enum Error {
     /// Cluster data ([`ClusterSet`](crate::cull::ClusterSet)) that does
     /// not fit the mesh or whose tree does not tile its clusters.
     InvalidClusters(crate::cull::ClusterFault),
+    /// [`Frame`](crate::Frame) with [`RasterMode::Clipless`]: its setup
+    /// storage holds snapped triangles only; draw clipless triangles with
+    /// a [`StripRenderer`](crate::StripRenderer).
+    ModeUnsupported,
 }
 
 impl core::fmt::Display for Error {
@@ -244,6 +269,10 @@ impl core::fmt::Display for Error {
                     write!(f, "cluster node {i} does not tile its clusters")
                 }
             },
+            Error::ModeUnsupported => write!(
+                f,
+                "a Frame stores snapped triangles only: draw clipless triangles with a StripRenderer"
+            ),
         }
     }
 }

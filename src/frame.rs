@@ -17,7 +17,7 @@
 
 use crate::bins::{self, Bins};
 use crate::color::PixelFormat;
-use crate::config::{check_rect, check_size, Config, Error};
+use crate::config::{check_rect, check_size, Config, Error, RasterMode};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
@@ -109,6 +109,9 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     ) -> Result<Self, Error> {
         const { check_subpixel_bits::<S>() };
         check_size(&config)?;
+        if config.mode != RasterMode::Clipping {
+            return Err(Error::ModeUnsupported);
+        }
         Ok(Frame {
             stage: Stage::new::<S>(config, None),
             store: Store { storage, len: 0 },

@@ -63,6 +63,7 @@
 //! | shading | `shade.rs` | [`Attributes`] (varyings per vertex: colours, lighting per vertex, texture coordinates, normals) and [`FragmentShader`] (varyings to colour: [`VertexColor`], textures, lighting per pixel), both chosen at compile time |
 //! | submission | `pipeline.rs` | [`Submit`]: object cull, frustum cull, strip skip, then clip and setup for each triangle |
 //! | clipping | `clip.rs` | outcodes; homogeneous clipping against near, far and the guard band |
+//! | clipless mode | `clipless.rs` | [`RasterMode::Clipless`]: quantized homogeneous vertices, exact 2D-homogeneous edge functions and spans, no clipping, no division by `w` |
 //! | fixed point | `fixed.rs` | snapping to `Sub<S>` window coordinates: where floats end |
 //! | setup | `setup.rs` | exact integer area, culling, winding, bounding box: [`SetupTriangle`] |
 //! | counters | `stats.rs` | [`Stats`] (per triangle), [`RenderStats`] (per pixel) |
@@ -86,6 +87,7 @@ pub mod cull;
 pub mod shade;
 pub mod pipeline;
 pub mod clip;
+pub mod clipless;
 pub mod fixed;
 pub mod setup;
 pub mod stats;
@@ -100,7 +102,7 @@ pub mod draw_target;
 pub use bins::Bins;
 pub use clip::ClipVertex;
 pub use color::{PixelFormat, TriangleId};
-pub use config::{Config, CullMode, Error, FrontFace};
+pub use config::{Config, CullMode, Error, FrontFace, RasterMode};
 pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Detail};
 pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};

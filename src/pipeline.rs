@@ -17,7 +17,7 @@
 //! fit. So a failed submission writes no storage slot and no counter.
 
 use crate::clip::{clip_triangle, outcode, ClipVertex};
-use crate::config::Error;
+use crate::config::{Error, RasterMode};
 use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Detail, Eye, Visit};
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
@@ -34,6 +34,7 @@ pub const MAX_PIECES: usize = 7;
 /// Internals of [`Submit`]: not part of the API.
 #[doc(hidden)]
 pub mod __private {
+    use crate::clipless::ClipLessTriangle;
     use crate::config::Config;
     use crate::math::Vec4;
     use crate::setup::SetupTriangle;
@@ -91,6 +92,14 @@ pub mod __private {
         fn capacity(&self) -> usize;
         /// Takes one piece; called only while `room() > 0`.
         fn take(&mut self, t: &SetupTriangle<N>);
+        /// Takes one clipless triangle ([`RasterMode::Clipless`]); called
+        /// only while `room() > 0`. Receivers that cannot draw them refuse
+        /// the mode when they are made, so by default it is dropped.
+        ///
+        /// [`RasterMode::Clipless`]: crate::RasterMode::Clipless
+        fn take_clipless(&mut self, t: &ClipLessTriangle<N>) {
+            let _ = t;
+        }
     }
 
     /// A receiver's parts, borrowed for one submission.
@@ -117,6 +126,9 @@ impl<const N: usize> Sink<N> for Counter {
         usize::MAX
     }
     fn take(&mut self, _: &SetupTriangle<N>) {
+        self.0 = self.0.saturating_add(1);
+    }
+    fn take_clipless(&mut self, _: &crate::clipless::ClipLessTriangle<N>) {
         self.0 = self.0.saturating_add(1);
     }
 }
@@ -242,7 +254,13 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         if culled_object(&mut self.parts(), mesh, mvp, n) {
             return Ok(());
         }
-        let eye = Eye::for_frame::<S>(mvp, &self.stage().config);
+        // Facing is decided by snapped areas in the clipping mode, which
+        // the size guard bounds; the clipless mode's determinants are not
+        // bounded so, so there clusters are culled by detail only.
+        let eye = match self.stage().config.mode {
+            RasterMode::Clipping => Eye::for_frame::<S>(mvp, &self.stage().config),
+            RasterMode::Clipless => None,
+        };
         let detail = Detail::for_frame(mvp, &self.stage().config);
         let list = set.vertices;
         let drawn = |f: &mut dyn FnMut(&Cluster)| {
@@ -674,7 +692,12 @@ impl<A> ProcessedJob<'_, A> {
                 Some(v)
             };
             let vars = || checked.unwrap_or_else(|| [var(0), var(1), var(2)]);
-            if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped {
+            if or & outcode::CLIP == 0
+                && a.snapped
+                && b.snapped
+                && d.snapped
+                && c.mode == RasterMode::Clipping
+            {
                 // Fast path: vertices already snapped.
                 match setup_geometry::<S>(
                     &[a.snap, b.snap, d.snap],
@@ -868,6 +891,16 @@ fn process_finite<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
     sink: &mut K,
 ) {
     let c = &stage.config;
+    if c.mode == RasterMode::Clipless {
+        match crate::clipless::setup::<N>(tri, c.width, c.height, c.cull, c.front_face, id) {
+            Ok(t) => {
+                sink.take_clipless(&t);
+                stats.stored += 1;
+            }
+            Err(r) => count_rejected(stats, r),
+        }
+        return;
+    }
     let (gx, gy) = stage.guard;
     let crossing = (codes[0] | codes[1] | codes[2]) & outcode::CLIP;
     if crossing == 0 {

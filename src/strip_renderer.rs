@@ -62,6 +62,11 @@ impl<
         self.render.pixels_written +=
             draw::<S, N, C, D, F>(t, &mut self.strip, &self.fragment) as u64;
     }
+    #[inline]
+    fn take_clipless(&mut self, t: &crate::clipless::ClipLessTriangle<N>) {
+        self.render.pixels_written +=
+            crate::clipless::draw::<N, C, D, F>(t, &mut self.strip, &self.fragment) as u64;
+    }
 }
 
 /// Draws triangles straight into rows `y0..y1` of a frame, at `S` subpixel
