@@ -114,6 +114,16 @@ impl ClusterCullArg {
     }
 }
 
+/// How triangles become pixels (the core's `RasterMode`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeArg {
+    /// Clip in homogeneous space, divide by w, snap, rasterize (the default).
+    Clipping,
+    /// No clipping, no division: 2D-homogeneous edge functions of quantized
+    /// vertices (Olano and Greer); strips set every triangle up again.
+    Clipless,
+}
+
 /// Which triangles face away and are skipped.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CullArg {
@@ -241,6 +251,10 @@ pub struct RenderArgs {
     /// Sub-pixel precision in bits (4 or 8).
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
+
+    /// Rasterization mode (clipless: no --tile, no --cull-clusters, no --obj).
+    #[arg(long, value_enum, default_value_t = ModeArg::Clipping)]
+    pub mode: ModeArg,
 
     /// Output image (.png or .ppm) [default: named after the scene, or the
     /// OBJ file's stem, e.g. spot.png].
@@ -476,6 +490,10 @@ pub struct BenchArgs {
     /// Sub-pixel precision in bits (4 or 8).
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
+
+    /// Rasterization mode (clipless: no --tile, no --cull-clusters, no --obj).
+    #[arg(long, value_enum, default_value_t = ModeArg::Clipping)]
+    pub mode: ModeArg,
 
     /// Timed frames per run.
     #[arg(long, value_name = "N", default_value = "50", value_parser = parse_frames)]

@@ -100,8 +100,8 @@ pub fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
 /// processed vertices `caches[object]` (`None`: outside the frustum, only
 /// counted, by `draw_mesh`), clip-space triangles one by one. Triangle ids
 /// count from 0 over the whole scene, objects first.
-pub fn fill<const S: u32>(
-    frame: &mut Frame<'_, S>,
+pub fn fill<const S: u32, K: Submit<S>>(
+    frame: &mut K,
     scene: &Scene,
     pieces: &[Piece],
     caches: &[Option<&[ProcessedVertex]>],

@@ -12,10 +12,14 @@
 //! triangles in submission order in every strip, so the image is
 //! byte-identical for any thread count and any strip height.
 
-use crate::pipeline::{draw_layers, FramePipeline, Layer};
+use crate::pipeline::{draw_layers, fill, for_each_strip, FramePipeline, Layer};
 use crate::scene::Scene;
 use microraster::pixelcolor::{Rgb888, RgbColor};
-use microraster::{Config, CullMode, PixelFormat, Stats, TriangleId};
+use microraster::prelude::{DepthWord, Submit};
+use microraster::{
+    Config, CullMode, NoDepth, PixelFormat, ProcessedVertex, RasterMode, Stats, StripRenderer,
+    TriangleId,
+};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -57,6 +61,8 @@ pub struct RenderOptions {
     pub tile_width: u32,
     /// Also render the triangle-id image.
     pub ids: bool,
+    /// Clipping or clipless rasterization.
+    pub mode: RasterMode,
 }
 
 /// The depth image of a render.
@@ -189,6 +195,9 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
 }
 
 fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
+    if opts.mode == RasterMode::Clipless {
+        return render_clipless::<S>(scene, opts);
+    }
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
@@ -230,6 +239,134 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
         stats: setup.stats,
         pixels_written,
         timings,
+    })
+}
+
+/// The clipless mode: no frame stores set-up triangles
+/// ([`Frame`](microraster::Frame) refuses the mode), so every strip, on
+/// the threads, draws the whole scene with a
+/// [`StripRenderer`](microraster::StripRenderer), from vertices processed
+/// once per frame. The counters are summed over the strips (each one sets
+/// up the triangles that reach it).
+fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
+    if opts.tile_width > 0 && opts.tile_width < opts.width {
+        return Err("--mode clipless draws strips, not tiles: drop --tile".to_string());
+    }
+    let (w, h) = (opts.width, opts.height);
+    let mut config = Config::new(w, h);
+    config.cull = opts.cull;
+    config.detail = opts.detail;
+    config.mode = RasterMode::Clipless;
+    let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
+    let len = w as usize * h as usize;
+    let t0 = Instant::now();
+    // The vertex stage, once per object (it depends on the configuration
+    // only), through a one-row renderer that draws nothing.
+    let caches: Vec<Vec<ProcessedVertex>> = {
+        let mut row = vec![TriangleId(0); w as usize];
+        let mut none = NoDepth;
+        let probe = StripRenderer::<_, _, S>::with_subpixel_bits(config, 0, 1, &mut row, &mut none)
+            .map_err(|e| e.to_string())?;
+        scene
+            .objects
+            .iter()
+            .map(|o| {
+                let mut c = vec![ProcessedVertex::EMPTY; o.positions.len()];
+                Submit::<S>::process_vertices(&probe, &o.mvp, &o.positions, &mut c);
+                c
+            })
+            .collect()
+    };
+    let cache_refs: Vec<Option<&[ProcessedVertex]>> =
+        caches.iter().map(|c| Some(c.as_slice())).collect();
+    let pieces = crate::pipeline::partition(scene, 1).concat();
+    let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let stats = std::sync::Mutex::new(Stats::default());
+    let draw =
+        |color: &mut [Rgb888], ids: Option<&mut [TriangleId]>, depth: DepthKind, count: bool| {
+            macro_rules! strips {
+                ($c:expr, $clear:expr, $d:expr) => {
+                    for_each_strip($c, $d, w as usize, rows as usize, threads, |y0, c, d| {
+                        c.fill($clear);
+                        let y1 = y0 + (c.len() / w as usize) as u32;
+                        let (written, st) = match d {
+                            Some(d) => {
+                                d.fill(DepthWord::FAR);
+                                let mut r = StripRenderer::<_, _, S>::with_subpixel_bits(
+                                    config, y0, y1, c, d,
+                                )?;
+                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                                (r.render_stats().pixels_written, r.stats())
+                            }
+                            None => {
+                                let mut none = NoDepth;
+                                let mut r = StripRenderer::<_, _, S>::with_subpixel_bits(
+                                    config, y0, y1, c, &mut none,
+                                )?;
+                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                                (r.render_stats().pixels_written, r.stats())
+                            }
+                        };
+                        if count {
+                            if let Ok(mut s) = stats.lock() {
+                                *s += st;
+                            }
+                        }
+                        Ok(written)
+                    })
+                };
+            }
+            macro_rules! kinds {
+                ($c:expr, $clear:expr) => {
+                    match depth {
+                        DepthKind::U16 => {
+                            let mut d = vec![u16::MAX; len];
+                            strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U16(d), px))
+                        }
+                        DepthKind::U32 => {
+                            let mut d = vec![u32::MAX; len];
+                            strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U32(d), px))
+                        }
+                        DepthKind::None => {
+                            strips!($c, $clear, None::<&mut [u32]>).map(|px| (DepthImage::None, px))
+                        }
+                    }
+                };
+            }
+            match ids {
+                Some(ids) => kinds!(ids, TriangleId(0)),
+                None => kinds!(color, BACKGROUND),
+            }
+            .map_err(|e| e.to_string())
+        };
+    let mut color = vec![BACKGROUND; len];
+    let t1 = Instant::now();
+    let (depth, pixels_written) = draw(&mut color, None, opts.depth, true)?;
+    let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
+    let t2 = Instant::now();
+    let ids = if opts.ids {
+        let mut ids = vec![TriangleId(0); len];
+        draw(&mut [], Some(&mut ids), opts.depth, false)?;
+        Some(ids.into_iter().map(|t| t.0).collect())
+    } else {
+        None
+    };
+    let ids_ms = t2.elapsed().as_secs_f64() * 1e3;
+    let rgb = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+    let stats = stats.into_inner().unwrap_or_default();
+    Ok(Rendered {
+        width: w,
+        height: h,
+        rgb,
+        ids,
+        depth,
+        stats,
+        pixels_written,
+        timings: Timings {
+            setup_ms,
+            raster_ms,
+            ids_ms,
+        },
     })
 }
 
@@ -280,6 +417,7 @@ mod tests {
             strip_rows,
             tile_width: 0,
             ids: true,
+            mode: RasterMode::Clipping,
         }
     }
 

@@ -380,12 +380,22 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         strip_rows: args.tile.map_or(args.strip_rows, |t| t.1),
         tile_width: args.tile.map_or(0, |t| t.0),
         ids: args.id_out.is_some(),
+        mode: match args.mode {
+            crate::cli::ModeArg::Clipping => microraster::RasterMode::Clipping,
+            crate::cli::ModeArg::Clipless => microraster::RasterMode::Clipless,
+        },
     };
     let (r, load_warnings) = match args.source() {
         Source::Obj(_) if args.cull_clusters.is_some() => {
             return Err(
                 "--cull-clusters is not yet supported with --obj (lit models); \
                  use --scene, or `microraster bench --obj FILE --cull-clusters TEST`"
+                    .to_string(),
+            )
+        }
+        Source::Obj(_) if opts.mode == microraster::RasterMode::Clipless => {
+            return Err(
+                "--mode clipless is not yet supported with --obj (lit models); use --scene or --clip-tris"
                     .to_string(),
             )
         }

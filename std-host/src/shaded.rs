@@ -532,6 +532,7 @@ mod tests {
             strip_rows,
             tile_width: 0,
             ids: true,
+            mode: microraster::RasterMode::Clipping,
         }
     }
 

@@ -105,6 +105,69 @@ fn output_is_identical_for_any_threads_and_strip_rows() {
     }
 }
 
+/// `--mode clipless`: the same image, ids and depth for any thread count
+/// and strip height, close to the clipping mode's (the quantizations
+/// differ by a hair at edges), and a typed error where it cannot apply.
+#[test]
+fn clipless_mode_renders_the_same_frame_for_any_split() {
+    for scene in ["cubes", "sphere"] {
+        let base = outputs(
+            &format!("clipless-{scene}-1"),
+            &[
+                "--scene",
+                scene,
+                "--mode",
+                "clipless",
+                "--threads",
+                "1",
+                "--strip-rows",
+                "600",
+            ],
+        );
+        for (t, r) in [("2", "16"), ("3", "7"), ("2", "1")] {
+            let other = outputs(
+                &format!("clipless-{scene}-{t}-{r}"),
+                &[
+                    "--scene",
+                    scene,
+                    "--mode",
+                    "clipless",
+                    "--threads",
+                    t,
+                    "--strip-rows",
+                    r,
+                ],
+            );
+            assert!(base == other, "{scene}: threads {t} strip rows {r} differ");
+        }
+        let (clipless, _) = stats(&["--scene", scene, "--mode", "clipless"]);
+        let (clipping, _) = stats(&["--scene", scene]);
+        let px = |v: &Value| v["counters"]["pixels_written"].as_u64().unwrap() as f64;
+        assert!((px(&clipless) / px(&clipping) - 1.0).abs() < 0.002);
+    }
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
+    let e = fails(&[
+        "render",
+        "--obj",
+        spot,
+        "--mode",
+        "clipless",
+        "--out",
+        tmp("c.png").to_str().unwrap(),
+    ]);
+    assert!(e.contains("clipless"), "{e}");
+    let e = fails(&[
+        "render",
+        "--mode",
+        "clipless",
+        "--tile",
+        "32x32",
+        "--out",
+        tmp("c.png").to_str().unwrap(),
+    ]);
+    assert!(e.contains("tiles"), "{e}");
+}
+
 /// The colour, id and depth outputs of `render` with `extra` arguments.
 fn outputs(tag: &str, extra: &[&str]) -> [Vec<u8>; 3] {
     let (img, ids, depth) = (

@@ -179,6 +179,7 @@ fn a_clustered_scene_renders_the_same_image_on_threads() {
         strip_rows: 16,
         tile_width: 0,
         ids: false,
+        mode: microraster::RasterMode::Clipping,
     };
     let want = render(&plain, &ro(1)).unwrap();
     for threads in [1, 2, 3] {

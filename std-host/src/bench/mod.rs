@@ -570,6 +570,7 @@ mod tests {
                 strip_rows: 16,
                 tile_width: 0,
                 ids: false,
+                mode: microraster::RasterMode::Clipping,
             };
             let want = render::render(&bs.scene, &opts).unwrap();
             let sum = format!("\"checksum\":\"{:016x}\"", want.checksum());

@@ -485,6 +485,7 @@ mod tests {
             strip_rows: 16,
             tile_width: 0,
             ids: false,
+            mode: microraster::RasterMode::Clipping,
         }
     }
 

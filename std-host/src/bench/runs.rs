@@ -358,6 +358,7 @@ fn render_fn_section(
         strip_rows: s.strip_rows,
         tile_width: s.tile_width,
         ids: false,
+        mode: microraster::RasterMode::Clipping,
     };
     let (mut total, mut setup, mut raster) = (Vec::new(), Vec::new(), Vec::new());
     let mut checksum = 0;
