@@ -193,9 +193,10 @@ pub enum Error {
     /// Cluster data ([`ClusterSet`](crate::cull::ClusterSet)) that does
     /// not fit the mesh or whose tree does not tile its clusters.
     InvalidClusters(crate::cull::ClusterFault),
-    /// [`Frame`](crate::Frame) with [`RasterMode::Clipless`]: its setup
-    /// storage holds snapped triangles only; draw clipless triangles with
-    /// a [`StripRenderer`](crate::StripRenderer).
+    /// [`RasterMode::Clipless`] given to a [`Frame`](crate::Frame), whose
+    /// setup storage holds snapped triangles only (draw clipless triangles
+    /// with a [`StripRenderer`](crate::StripRenderer)), or to any receiver
+    /// of a crate built without its `clipless` feature.
     ModeUnsupported,
 }
 
@@ -271,7 +272,7 @@ impl core::fmt::Display for Error {
             },
             Error::ModeUnsupported => write!(
                 f,
-                "a Frame stores snapped triangles only: draw clipless triangles with a StripRenderer"
+                "the clipless mode needs a StripRenderer (a Frame stores snapped triangles only) and the crate's clipless feature"
             ),
         }
     }

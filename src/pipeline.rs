@@ -644,6 +644,9 @@ impl<A> ProcessedJob<'_, A> {
         let c = &stage.config;
         // Attribute lists as long as the mesh need no check per triangle.
         let complete = attrs.complete(mesh.indices.len(), self.cache.len());
+        // The clipless mode sets up from clip-space positions, never from
+        // the snapped vertices.
+        let snapped_setup = c.mode == RasterMode::Clipping;
         let first = tris.start;
         for (j, idx) in mesh.indices.get(tris).unwrap_or(&[]).iter().enumerate() {
             let i = first + j;
@@ -692,12 +695,7 @@ impl<A> ProcessedJob<'_, A> {
                 Some(v)
             };
             let vars = || checked.unwrap_or_else(|| [var(0), var(1), var(2)]);
-            if or & outcode::CLIP == 0
-                && a.snapped
-                && b.snapped
-                && d.snapped
-                && c.mode == RasterMode::Clipping
-            {
+            if or & outcode::CLIP == 0 && a.snapped && b.snapped && d.snapped && snapped_setup {
                 // Fast path: vertices already snapped.
                 match setup_geometry::<S>(
                     &[a.snap, b.snap, d.snap],
@@ -891,14 +889,8 @@ fn process_finite<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
     sink: &mut K,
 ) {
     let c = &stage.config;
-    if c.mode == RasterMode::Clipless {
-        match crate::clipless::setup::<N>(tri, c.width, c.height, c.cull, c.front_face, id) {
-            Ok(t) => {
-                sink.take_clipless(&t);
-                stats.stored += 1;
-            }
-            Err(r) => count_rejected(stats, r),
-        }
+    if cfg!(feature = "clipless") && c.mode == RasterMode::Clipless {
+        process_clipless::<N, K>(stage, tri, id, stats, sink);
         return;
     }
     let (gx, gy) = stage.guard;
@@ -956,6 +948,29 @@ fn process_finite<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
     }
     if stored == 0 {
         count_rejected(stats, first_reason.unwrap_or(Rejected::Degenerate));
+    }
+}
+
+/// [`process_finite`] in the clipless mode: setup without clipping, one
+/// piece. Out of line, so that the clipping mode's stack frame does not
+/// hold a clipless triangle (immediate-mode firmware sizes its strips by
+/// the stack it measured).
+#[cold]
+#[inline(never)]
+fn process_clipless<const N: usize, K: Sink<N> + ?Sized>(
+    stage: &Stage,
+    tri: &[ClipVertex<N>; 3],
+    id: u32,
+    stats: &mut Stats,
+    sink: &mut K,
+) {
+    let c = &stage.config;
+    match crate::clipless::setup::<N>(tri, c.width, c.height, c.cull, c.front_face, id) {
+        Ok(t) => {
+            sink.take_clipless(&t);
+            stats.stored += 1;
+        }
+        Err(r) => count_rejected(stats, r),
     }
 }
 

@@ -158,6 +158,9 @@ where
     ) -> Result<Self, Error> {
         const { check_subpixel_bits::<S>() };
         check_size(&config)?;
+        if config.mode == crate::config::RasterMode::Clipless && !cfg!(feature = "clipless") {
+            return Err(Error::ModeUnsupported);
+        }
         check_rows(&config, y0, y1, color.len(), depth.depth_len())?;
         let whole = y0 == 0 && y1 == config.height;
         let h = config.height as f32;

@@ -11,6 +11,8 @@
 //! N_k`, `sum l_k F_k` are `>= 0`. Nothing is normalised, nothing is
 //! stepped.
 
+#![cfg(feature = "clipless")]
+
 mod common;
 
 use microraster::clipless::{determinant, quantize, HomVertex};

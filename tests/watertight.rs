@@ -62,6 +62,7 @@ fn counts<const S: u32>(mesh: &Mesh<'_>, mvp: &Mat4, w: u32, h: u32, cull: CullM
 
 /// The same counts in the clipless mode, drawn by a strip renderer in
 /// strips of 11 rows.
+#[cfg(feature = "clipless")]
 fn counts_clipless(mesh: &Mesh<'_>, mvp: &Mat4, w: u32, h: u32, cull: CullMode) -> Vec<u32> {
     let mut config = Config::new(w, h);
     config.cull = cull;
@@ -158,6 +159,7 @@ fn spot_front_and_back_face_counts_match_everywhere() {
 
 /// The clipless mode on the same mesh from 64 cameras (`S` = 0 in the
 /// messages: it has no subpixel grid).
+#[cfg(feature = "clipless")]
 #[test]
 fn spot_front_and_back_face_counts_match_everywhere_clipless() {
     let text = std::fs::read_to_string(concat!(

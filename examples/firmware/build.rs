@@ -161,6 +161,9 @@ fn frame_checksum(pixels: &[Rgb565]) -> u64 {
 
 #[cfg(not(feature = "spot"))]
 fn host_checksum(depth: bool) -> u64 {
+    if cfg!(feature = "clipless") {
+        return clipless_checksum(depth);
+    }
     let mut storage = vec![SetupTriangle::EMPTY; cubes::CUBE_INDICES.len() * 4 * 7];
     const S: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
     let mut frame =
@@ -180,6 +183,30 @@ fn host_checksum(depth: bool) -> u64 {
         frame.render_rows(0, HEIGHT, &mut color, &mut NoDepth)
     }
     .unwrap();
+    frame_checksum(&color)
+}
+
+/// The cubes in the clipless mode, drawn whole by one strip renderer.
+#[cfg(not(feature = "spot"))]
+fn clipless_checksum(depth: bool) -> u64 {
+    let mut config = Config::new(WIDTH, HEIGHT);
+    config.mode = microraster::RasterMode::Clipless;
+    let n = (WIDTH * HEIGHT) as usize;
+    let mut color = vec![Rgb565::BLACK; n];
+    let mut z = vec![u16::MAX; n];
+    let mut none = NoDepth;
+    let draw = |strip: &mut dyn FnMut(&microraster::Mesh<'_>, &microraster::Mat4, u32)| {
+        cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| strip(mesh, mvp, id));
+    };
+    if depth {
+        let mut r =
+            microraster::StripRenderer::new(config, 0, HEIGHT, &mut color, &mut z[..]).unwrap();
+        draw(&mut |m, mvp, id| r.submit_mesh(m, mvp, id).unwrap());
+    } else {
+        let mut r =
+            microraster::StripRenderer::new(config, 0, HEIGHT, &mut color, &mut none).unwrap();
+        draw(&mut |m, mvp, id| r.submit_mesh(m, mvp, id).unwrap());
+    }
     frame_checksum(&color)
 }
 

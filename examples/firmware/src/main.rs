@@ -171,7 +171,12 @@ type Vertices = [ProcessedVertex; 4 * 8];
 /// frame: the result does not depend on the strip).
 #[cfg(not(feature = "spot"))]
 fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
-    // A frame with no storage is enough to run the vertex stage.
+    // A frame with no storage is enough to run the vertex stage, which
+    // does not depend on the mode (a frame refuses the clipless one).
+    let config = Config {
+        mode: microraster::RasterMode::Clipping,
+        ..config
+    };
     let probe = microraster::Frame::<SUBPIXEL>::with_subpixel_bits(config, &mut []);
     if let Ok(probe) = probe {
         for (mvp, cache) in mvps.iter().zip(out.chunks_exact_mut(8)) {
@@ -247,7 +252,12 @@ fn main() -> ! {
     let depth = &mut DEPTH[..];
     #[cfg(feature = "no-depth")]
     let depth = microraster::NoDepth;
-    let config = Config::new(WIDTH, HEIGHT);
+    #[allow(unused_mut)]
+    let mut config = Config::new(WIDTH, HEIGHT);
+    #[cfg(feature = "clipless")]
+    {
+        config.mode = microraster::RasterMode::Clipless;
+    }
     let mut drawer = StripDrawer::new(&mut COLOR[..], depth, BLACK);
     let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
 
