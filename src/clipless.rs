@@ -9,17 +9,21 @@
 //! 1. **Quantize** ([`quantize`]). A clip-space vertex `(x, y, z, w)`
 //!    becomes homogeneous window coordinates, in `f32`: `X = (x + w) *
 //!    width`, `Y = (w - y) * height` (twice the window position, times
-//!    `w`), `W = w`, and the distances to the near and far planes,
-//!    `N = z + w` and `F = w - z`. The five share one binary exponent `e`
-//!    per vertex, the smallest for which all fit in [`MANTISSA_BITS`] = 22
-//!    bits: the format `Hom22` below, block floating point. A shared
-//!    vertex quantizes the same way in every triangle, so a shared edge
-//!    gets the same edge function (negated) in both: watertight by
-//!    construction.
+//!    `w`), `W = w D`, and the distances to the near and far planes,
+//!    `N = (z + w) D` and `F = (w - z) D`, where `D = max(width, height)`
+//!    ([`sample_scale`]) keeps all five of one magnitude (without it, `W`
+//!    would keep 11 bits fewer than `X` on a 2048-pixel frame: a pixel's
+//!    error in x). The five share one binary exponent `e` per vertex, the
+//!    smallest for which all fit in [`MANTISSA_BITS`] = 22 bits: the format
+//!    `Hom22` below, block floating point (relative error `2^-22` of the
+//!    largest, so a vertex lands within about `D 2^-21` pixels of where
+//!    `f32` puts it: 1/1024 px on a 2048-pixel frame). A shared vertex
+//!    quantizes the same way in every triangle, so a shared edge gets the
+//!    same edge function (negated) in both: watertight by construction.
 //! 2. **Edge functions** are cross products of two vertices' `(X, Y, W)`
 //!    mantissas, exactly, in `i64`: `e_k(p) = det(v_i, v_j, p) = a px + b
-//!    py + c` for the edge opposite vertex `k`, at pixel centres `p = (2
-//!    col + 1, 2 row + 1, 1)` in doubled window units. The determinant
+//!    py + c D` for the edge opposite vertex `k`, at pixel centres `p = (2
+//!    col + 1, 2 row + 1, D)` (doubled window units over `D`). The determinant
 //!    `det(v0, v1, v2)` (exact, `i128`) is zero for a degenerate triangle;
 //!    its sign is the winding, for every triangle, with vertices behind
 //!    the eye or not (the visible part of a triangle winds as its
@@ -40,7 +44,7 @@
 //!    span is the intersection, within the bounding box: the projected
 //!    vertices' box where all `w > 0`, the whole frame otherwise (the
 //!    paper's conservative box for triangles through `w = 0`).
-//! 5. **Depth** is window depth `N(p) / (2 det)` (`z/w` is linear on the
+//! 5. **Depth** is window depth `N(p) / (2 D det)` (`z/w` is linear on the
 //!    screen): evaluated exactly in `i128` at the span's first column, to
 //!    `f64`, then stepped in `Z32.F` integers as the clipping mode steps it.
 //!    Varyings are `sum e_k 2^-e_k v_k / sum e_k 2^-e_k`, perspective-correct
@@ -56,9 +60,9 @@
 //! |---|---|---|---|
 //! | `Hom22` | `i32` ×5 + exponent | `(X, Y, W, N, F) = m * 2^e` per vertex | `|m| <= 2^22`, `e` any `i32` |
 //! | edge coefficient | `i64` | `a`, `b`, `c` of `v_i x v_j` | `|.| <= 2 * 2^44 = 2^45` |
-//! | edge value | `i64` | `e_k` at a pixel centre, doubled coordinates `< 2^15` | `|e| <= 2^45 (2^15 + 2^15 + 1) < 2^62` |
+//! | edge value | `i64` | `e_k` at a pixel centre: doubled coordinates `< 2^15`, `D <= 2^14` | `|e| <= 2^45 (2^15 + 2^15 + 2^14) < 2^61` |
 //! | determinant | `i128` | `det(v0, v1, v2)` | `< 3 * 2^22 * 2^45 < 2^69` |
-//! | near/far value | `i128` | `sum e_k N_k` | `< 3 * 2^62 * 2^22 < 2^86` |
+//! | near/far value | `i128` | `sum e_k N_k` | `< 3 * 2^61 * 2^22 < 2^85` |
 
 use crate::clip::ClipVertex;
 use crate::color::PixelFormat;
@@ -82,12 +86,12 @@ pub struct HomVertex {
     pub x: i32,
     /// `(w - y) * height`: twice the window y (rows from the top), times `w`.
     pub y: i32,
-    /// `w`.
+    /// `w D` ([`sample_scale`]).
     pub w: i32,
-    /// `z + w`: the distance to the near plane (twice the window depth,
-    /// times `w`).
+    /// `(z + w) D`: the distance to the near plane (twice the window
+    /// depth, times `w D`).
     pub near: i32,
-    /// `w - z`: the distance to the far plane.
+    /// `(w - z) D`: the distance to the far plane.
     pub far: i32,
     /// The block exponent `e` shared by the five.
     pub exp: i32,
@@ -103,19 +107,21 @@ pub struct HomVertex {
 /// use microraster::clipless::{quantize, HomVertex};
 /// use microraster::Vec4;
 ///
-/// // The frame's centre at w = 1 on a 64x64 frame: X = Y = 64, W = 1.
+/// // The frame's centre at w = 1 on a 64x64 frame: X = Y = W = N = F
+/// // = 64 (D = 64).
 /// let v = quantize(Vec4::new(0.0, 0.0, 0.0, 1.0), 64, 64);
-/// assert_eq!((v.x, v.y, v.w), (1 << 21, 1 << 21, 1 << 15));
+/// assert_eq!((v.x, v.y, v.w, v.near, v.far), (1 << 21, 1 << 21, 1 << 21, 1 << 21, 1 << 21));
 /// ```
 pub fn quantize(p: Vec4, width: u32, height: u32) -> HomVertex {
     let (wf, hf) = (width as f32, height as f32);
+    let d = sample_scale(width, height) as f32;
     let lift = |p: Vec4| {
         [
             (p.x + p.w) * wf,
             (p.w - p.y) * hf,
-            p.w,
-            p.z + p.w,
-            p.w - p.z,
+            p.w * d,
+            (p.z + p.w) * d,
+            (p.w - p.z) * d,
         ]
     };
     let mut h = lift(p);
@@ -141,6 +147,13 @@ pub fn quantize(p: Vec4, width: u32, height: u32) -> HomVertex {
         far: q[4],
         exp: exp + pre,
     }
+}
+
+/// `D = max(width, height)`: the third coordinate of a pixel centre
+/// `(2 col + 1, 2 row + 1, D)`, and the scale of `W`, `N` and `F` (see
+/// the module's note).
+pub fn sample_scale(width: u32, height: u32) -> i64 {
+    width.max(height) as i64
 }
 
 /// `floor(log2 |v|)` of a finite, non-zero `f32` given by its magnitude's
@@ -207,7 +220,8 @@ pub struct ClipLessTriangle<const N: usize = 3> {
     c: [i64; 3],
     /// 0 for a top or left edge, 1 otherwise.
     t: [i64; 3],
-    /// `sum e_k N_k` as `(A, B, C)` over doubled pixel coordinates.
+    /// `sum e_k N_k` as `(A, B, C)`: `A px + B py + C` (`C` with `D` in
+    /// it).
     near: [i128; 3],
     /// `sum e_k F_k`, the same way.
     far: [i128; 3],
@@ -277,7 +291,8 @@ pub(crate) fn setup<const N: usize>(
         _ => {}
     }
     let s = if det < 0 { -1 } else { 1 };
-    let bbox = bounding_box(&h, width, height)?;
+    let d = sample_scale(width, height);
+    let bbox = bounding_box(&h, width, height, d)?;
     let mut a = [0i64; 3];
     let mut b = [0i64; 3];
     let mut c = [0i64; 3];
@@ -291,12 +306,14 @@ pub(crate) fn setup<const N: usize>(
             1
         };
     }
-    let plane = |d: [i32; 3]| {
+    // Edge constants at the pixel centres' third coordinate D.
+    let c = c.map(|c| c * d);
+    let plane = |n: [i32; 3]| {
         let mut p = [0i128; 3];
         for k in 0..3 {
-            p[0] += a[k] as i128 * d[k] as i128;
-            p[1] += b[k] as i128 * d[k] as i128;
-            p[2] += c[k] as i128 * d[k] as i128;
+            p[0] += a[k] as i128 * n[k] as i128;
+            p[1] += b[k] as i128 * n[k] as i128;
+            p[2] += c[k] as i128 * n[k] as i128;
         }
         p
     };
@@ -330,7 +347,7 @@ pub(crate) fn setup<const N: usize>(
         near,
         far,
         clip_depth,
-        z_scale: 2_147_483_648.0 / (s as i128 * det) as f64,
+        z_scale: 2_147_483_648.0 / (s as i128 * det * d as i128) as f64,
         bbox,
         weight,
         var_w,
@@ -348,16 +365,16 @@ fn pow2_neg(d: i32) -> f32 {
 
 /// The pixels whose centres may be covered: the projected vertices' box
 /// where every `w > 0`, the whole frame otherwise; clamped to the frame.
-fn bounding_box(h: &[HomVertex; 3], width: u32, height: u32) -> Result<[u16; 4], Rejected> {
+fn bounding_box(h: &[HomVertex; 3], width: u32, height: u32, d: i64) -> Result<[u16; 4], Rejected> {
     let (wmax, hmax) = (width as i64 - 1, height as i64 - 1);
     if h.iter().any(|h| h.w <= 0) {
         return Ok([0, wmax as u16, 0, hmax as u16]);
     }
     // Column `i` has its centre at doubled x `2i + 1`; a vertex at doubled
-    // x `X / W`. The columns at or right of it start at
-    // `ceil((X - W) / 2W)`, those at or left of it end at the floor.
-    let lo = |v: i32, w: i32| -((w as i64 - v as i64).div_euclid(2 * w as i64));
-    let hi = |v: i32, w: i32| (v as i64 - w as i64).div_euclid(2 * w as i64);
+    // x `X D / W`. The columns at or right of it start at
+    // `ceil((X D - W) / 2W)`, those at or left of it end at the floor.
+    let lo = |v: i32, w: i32| -((w as i64 - v as i64 * d).div_euclid(2 * w as i64));
+    let hi = |v: i32, w: i32| (v as i64 * d - w as i64).div_euclid(2 * w as i64);
     let fold = |f: &dyn Fn(i32, i32) -> i64, g: fn(i64, i64) -> i64, y: bool| {
         let c = |k: usize| f(if y { h[k].y } else { h[k].x }, h[k].w);
         g(g(c(0), c(1)), c(2))
@@ -582,11 +599,11 @@ mod tests {
     #[test]
     fn quantization_is_exact_for_small_integers() {
         let q = quantize(Vec4::new(0.5, -0.25, 0.0, 2.0), 100, 60);
-        // X = 2.5 * 100 = 250, Y = 2.25 * 60 = 135, W = 2, N = 2, F = 2.
+        // X = 2.5 * 100 = 250, Y = 2.25 * 60 = 135, W = N = F = 2 * 100.
         let s = |m: i32| m as f64 * 2f64.powi(q.exp);
         assert_eq!(
             (s(q.x), s(q.y), s(q.w), s(q.near), s(q.far)),
-            (250.0, 135.0, 2.0, 2.0, 2.0)
+            (250.0, 135.0, 200.0, 200.0, 200.0)
         );
     }
 

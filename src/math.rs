@@ -405,6 +405,40 @@ impl Mat4 {
         ])
     }
 
+    /// A perspective projection whose window depth is `near / w`: 1/w
+    /// depth, reversed (1 at the near plane, towards 0 far away) and with
+    /// no far plane. Clip `z = 2 near - w` (eye space looking down -z, `w =
+    /// -z_eye`), so the clip volume's `z <= w` is `w >= near` and `z >= -w`
+    /// always holds; window depth `(z/w + 1) / 2 = near / w` is affine on
+    /// the screen, so both rasterization modes interpolate it exactly as
+    /// they interpolate window z. Draw with
+    /// [`DepthFunc::Greater`](crate::DepthFunc::Greater) (or
+    /// `GreaterEqual`) into buffers cleared to 0. In `u16` and `u32`
+    /// buffers it has the precision of window z for the same near plane
+    /// (both are affine in `1/w`: `d(near/w) = (far - near)/far dz`, within
+    /// `near/far` of it), and nothing is clipped far away.
+    ///
+    /// ```
+    /// use microraster::{Mat4, Vec3};
+    /// let p = Mat4::perspective_inv_w(1.0, 1.0, 0.5);
+    /// let c = p.transform_point(Vec3::new(0.0, 0.0, -4.0));
+    /// assert_eq!(((c.z / c.w + 1.0) / 2.0, c.w), (0.125, 4.0));
+    /// ```
+    pub fn perspective_inv_w(fov_y_radians: f32, aspect: f32, near: f32) -> Mat4 {
+        Mat4::perspective_inv_w_with::<DefaultFloat>(fov_y_radians, aspect, near)
+    }
+
+    /// [`Mat4::perspective_inv_w`] with the float backend `F`.
+    pub fn perspective_inv_w_with<F: FloatFns>(fov_y_radians: f32, aspect: f32, near: f32) -> Mat4 {
+        let f = 1.0 / F::tan(fov_y_radians * 0.5);
+        Mat4::from_rows([
+            [f / aspect, 0.0, 0.0, 0.0],
+            [0.0, f, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 2.0 * near],
+            [0.0, 0.0, -1.0, 0.0],
+        ])
+    }
+
     /// A right-handed view matrix looking from `eye` at `target`, like
     /// `gluLookAt`.
     pub fn look_at(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {

@@ -60,8 +60,10 @@ fn det3(a: V3, b: V3, c: V3) -> i128 {
 }
 
 /// Whether the quantized triangle `h` covers the centre of pixel `(col,
-/// row)` (see the file's note), culling as `cull` with CCW front faces.
-fn reference_covers(h: &[HomVertex; 3], col: i64, row: i64, cull: CullMode) -> bool {
+/// row)` (see the file's note), culling as `cull` with CCW front faces, on
+/// a frame whose larger side is `scale` (the centre is `(2 col + 1, 2 row +
+/// 1, scale)` in the quantized vertices' coordinates).
+fn reference_covers(h: &[HomVertex; 3], col: i64, row: i64, scale: i64, cull: CullMode) -> bool {
     let v = |k: usize| [h[k].x as i128, h[k].y as i128, h[k].w as i128];
     let d = det3(v(0), v(1), v(2));
     if d == 0 {
@@ -79,7 +81,7 @@ fn reference_covers(h: &[HomVertex; 3], col: i64, row: i64, cull: CullMode) -> b
         m[k] = p;
         det3(m[0], m[1], m[2]) * sign
     };
-    let p = [2 * col as i128 + 1, 2 * row as i128 + 1, 1];
+    let p = [2 * col as i128 + 1, 2 * row as i128 + 1, scale as i128];
     let mut l = [0i128; 3];
     for (k, lk) in l.iter_mut().enumerate() {
         *lk = weight(k, p);
@@ -87,8 +89,8 @@ fn reference_covers(h: &[HomVertex; 3], col: i64, row: i64, cull: CullMode) -> b
             return false;
         }
         if *lk == 0 {
-            let gx = weight(k, [p[0] + 2, p[1], 1]) - *lk;
-            let gy = weight(k, [p[0], p[1] + 2, 1]) - *lk;
+            let gx = weight(k, [p[0] + 2, p[1], p[2]]) - *lk;
+            let gy = weight(k, [p[0], p[1] + 2, p[2]]) - *lk;
             if !(gx > 0 || (gx == 0 && gy > 0)) {
                 return false;
             }
@@ -107,7 +109,7 @@ fn reference(config: Config, tris: &[[Vec4; 3]]) -> Vec<u32> {
     for row in 0..h as i64 {
         for col in 0..w as i64 {
             for (i, t) in q.iter().enumerate() {
-                if reference_covers(t, col, row, config.cull) {
+                if reference_covers(t, col, row, w.max(h) as i64, config.cull) {
                     out[(row * w as i64 + col) as usize] = i as u32 + 1;
                 }
             }
@@ -391,7 +393,7 @@ fn frame_refuses_the_clipless_mode() {
     assert_eq!(r.err(), Some(Error::ModeUnsupported));
 }
 
-/// Depth is the floor of the exact `N(p) / (2 det)` in `Z32`, or one off
+/// Depth is the floor of the exact `N(p) / (2 D det)` in `Z32`, or one off
 /// (stepping error where the value lies that close to an integer), on
 /// triangles crossing the near plane and behind-the-eye wedges too.
 #[test]
@@ -420,7 +422,7 @@ fn depth_within_one_lsb_of_the_exact_plane() {
                 let i = (row * w as i64 + col) as usize;
                 assert_eq!(
                     ids[i].0 != 0,
-                    reference_covers(&q, col, row, CullMode::None),
+                    reference_covers(&q, col, row, w.max(h) as i64, CullMode::None),
                     "case {case} ({col}, {row})"
                 );
                 if ids[i].0 == 0 {
@@ -428,7 +430,8 @@ fn depth_within_one_lsb_of_the_exact_plane() {
                 }
                 // N(p) by Cramer's rule, then Z32 = N 2^31 / det, in f64
                 // from exact integers (|error| far below 1 LSB).
-                let p = [2 * col as i128 + 1, 2 * row as i128 + 1, 1];
+                let dd = w.max(h) as i128;
+                let p = [2 * col as i128 + 1, 2 * row as i128 + 1, dd];
                 let vk = |k: usize| [q[k].x as i128, q[k].y as i128, q[k].w as i128];
                 let n: i128 = (0..3)
                     .map(|k| {
@@ -437,7 +440,7 @@ fn depth_within_one_lsb_of_the_exact_plane() {
                         det3(m[0], m[1], m[2]) * q[k].near as i128
                     })
                     .sum();
-                let exact = n as f64 / d as f64 * 2_147_483_648.0;
+                let exact = n as f64 / (d * dd) as f64 * 2_147_483_648.0;
                 let got = depth[i] as f64;
                 assert!(
                     (got - exact.clamp(0.0, 4_294_967_295.0).floor()).abs() <= 1.0,

@@ -221,7 +221,7 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spi
     // On a unit sphere the position is the normal.
     let colors = normal_colors(&positions);
     let fov = view.fov.unwrap_or(45.0);
-    let proj = Mat4::perspective(fov.to_radians(), view.aspect(), 1.0, 100.0);
+    let proj = view.projection(fov.to_radians(), 1.0, 100.0);
     let view_m = match (view.eye, view.target) {
         (None, None) => Mat4::IDENTITY,
         (eye, target) => scene::look_at(
@@ -338,6 +338,7 @@ pub fn gouraud_mesh_scene(
         target,
         fov,
         view.aspect(),
+        view.inv_w,
     )?;
     let light = (Vec3::from_array(eye) - Vec3::from_array(target)).normalize();
     let colors = vertex_normals(&positions, &indices)
@@ -399,6 +400,7 @@ mod tests {
             tile_width: 0,
             ids: false,
             mode: microraster::RasterMode::Clipping,
+            inv_w: false,
         }
     }
 

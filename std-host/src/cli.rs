@@ -124,6 +124,17 @@ pub enum ModeArg {
     Clipless,
 }
 
+/// What the depth buffer holds.
+#[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DepthKindArg {
+    /// Window depth z (the default): 0 at the near plane, 1 at the far.
+    #[default]
+    Z,
+    /// 1/w: near / w, reversed (1 at the near plane, towards 0 far away;
+    /// depth test greater, cleared to 0), no far plane.
+    InvW,
+}
+
 /// Which triangles face away and are skipped.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CullArg {
@@ -252,9 +263,14 @@ pub struct RenderArgs {
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
 
-    /// Rasterization mode (clipless: no --tile, no --cull-clusters, no --obj).
+    /// Rasterization mode (clipless: no --tile, no --obj).
     #[arg(long, value_enum, default_value_t = ModeArg::Clipping)]
     pub mode: ModeArg,
+
+    /// What the depth buffer holds (inv-w: the built-in scenes and --obj
+    /// only; not with --clip-tris, whose z is the file's).
+    #[arg(long, value_enum, default_value_t = DepthKindArg::Z)]
+    pub depth_kind: DepthKindArg,
 
     /// Output image (.png or .ppm) [default: named after the scene, or the
     /// OBJ file's stem, e.g. spot.png].
@@ -490,10 +506,6 @@ pub struct BenchArgs {
     /// Sub-pixel precision in bits (4 or 8).
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
-
-    /// Rasterization mode (clipless: no --tile, no --cull-clusters, no --obj).
-    #[arg(long, value_enum, default_value_t = ModeArg::Clipping)]
-    pub mode: ModeArg,
 
     /// Timed frames per run.
     #[arg(long, value_name = "N", default_value = "50", value_parser = parse_frames)]

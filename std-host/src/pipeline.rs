@@ -384,6 +384,19 @@ pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
     threads: usize,
     clear: Option<C>,
 ) -> Result<u64, Error> {
+    draw_layers_cleared(layers, color, depth, threads, clear, T::FAR)
+}
+
+/// [`draw_layers`] clearing depth to `depth_clear` (0 for 1/w depth,
+/// whose test is `Greater`) instead of [`DepthWord::FAR`].
+pub fn draw_layers_cleared<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
+    layers: &[Layer<'_, '_, S>],
+    color: &mut [C],
+    depth: Option<&mut [T]>,
+    threads: usize,
+    clear: Option<C>,
+    depth_clear: T,
+) -> Result<u64, Error> {
     let Some((first, bins)) = layers.first() else {
         return Ok(0);
     };
@@ -400,7 +413,7 @@ pub fn draw_layers<const S: u32, C: PixelFormat + Send + Sync, T: DepthWord>(
             if let Some(v) = clear {
                 c.fill(v);
                 if let Some(d) = d.as_deref_mut() {
-                    d.fill(T::FAR);
+                    d.fill(depth_clear);
                 }
             }
             let mut written = 0;

@@ -12,13 +12,15 @@
 //! triangles in submission order in every strip, so the image is
 //! byte-identical for any thread count and any strip height.
 
-use crate::pipeline::{draw_layers, fill, for_each_strip, FramePipeline, Layer};
+use crate::pipeline::{
+    draw_layers, draw_layers_cleared, fill, for_each_strip, FramePipeline, Layer,
+};
 use crate::scene::Scene;
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::prelude::{DepthWord, Submit};
 use microraster::{
-    Config, CullMode, NoDepth, PixelFormat, ProcessedVertex, RasterMode, Stats, StripRenderer,
-    TriangleId,
+    Config, CullMode, DepthFunc, NoDepth, PixelFormat, ProcessedVertex, RasterMode, Stats,
+    StripRenderer, TriangleId,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -63,6 +65,9 @@ pub struct RenderOptions {
     pub ids: bool,
     /// Clipping or clipless rasterization.
     pub mode: RasterMode,
+    /// 1/w depth (the scene built with `View::inv_w`): depth test
+    /// `Greater`, depth cleared to 0 instead of the far plane.
+    pub inv_w: bool,
 }
 
 /// The depth image of a render.
@@ -202,6 +207,9 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
     config.detail = opts.detail;
+    if opts.inv_w {
+        config.depth_func = DepthFunc::Greater;
+    }
     let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
     let len = w as usize * h as usize;
     let t0 = Instant::now();
@@ -211,12 +219,12 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
             let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
             let mut color = vec![BACKGROUND; len];
             let t1 = Instant::now();
-            let (depth, px) = draw_image(layers, &mut color, opts.depth, BACKGROUND, threads)?;
+            let (depth, px) = draw_image(layers, &mut color, opts, BACKGROUND)?;
             let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
             let t2 = Instant::now();
             let ids = if opts.ids {
                 let mut ids = vec![TriangleId(0); len];
-                draw_image(layers, &mut ids, opts.depth, TriangleId(0), threads)?;
+                draw_image(layers, &mut ids, opts, TriangleId(0))?;
                 Some(ids.into_iter().map(|t| t.0).collect())
             } else {
                 None
@@ -257,6 +265,10 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
     config.cull = opts.cull;
     config.detail = opts.detail;
     config.mode = RasterMode::Clipless;
+    if opts.inv_w {
+        config.depth_func = DepthFunc::Greater;
+    }
+    let reversed = opts.inv_w;
     let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
     let len = w as usize * h as usize;
     let t0 = Instant::now();
@@ -291,7 +303,11 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
                         let y1 = y0 + (c.len() / w as usize) as u32;
                         let (written, st) = match d {
                             Some(d) => {
-                                d.fill(DepthWord::FAR);
+                                d.fill(if reversed {
+                                    DepthWord::from_z32(0)
+                                } else {
+                                    DepthWord::FAR
+                                });
                                 let mut r = StripRenderer::<_, _, S>::with_subpixel_bits(
                                     config, y0, y1, c, d,
                                 )?;
@@ -320,11 +336,11 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
                 ($c:expr, $clear:expr) => {
                     match depth {
                         DepthKind::U16 => {
-                            let mut d = vec![u16::MAX; len];
+                            let mut d = vec![if reversed { 0 } else { u16::MAX }; len];
                             strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U16(d), px))
                         }
                         DepthKind::U32 => {
-                            let mut d = vec![u32::MAX; len];
+                            let mut d = vec![if reversed { 0 } else { u32::MAX }; len];
                             strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U32(d), px))
                         }
                         DepthKind::None => {
@@ -376,20 +392,22 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
 fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
     layers: &[Layer<'_, '_, S>],
     color: &mut [C],
-    kind: DepthKind,
+    opts: &RenderOptions,
     clear: C,
-    threads: usize,
 ) -> Result<(DepthImage, u64), String> {
     let len = color.len();
-    let (depth, px) = match kind {
+    let threads = opts.threads.max(1);
+    let (depth, px) = match opts.depth {
         DepthKind::U16 => {
-            let mut d = vec![u16::MAX; len];
-            let px = draw_layers(layers, color, Some(&mut d[..]), threads, Some(clear));
+            let z: u16 = if opts.inv_w { 0 } else { u16::MAX };
+            let mut d = vec![z; len];
+            let px = draw_layers_cleared(layers, color, Some(&mut d[..]), threads, Some(clear), z);
             (DepthImage::U16(d), px)
         }
         DepthKind::U32 => {
-            let mut d = vec![u32::MAX; len];
-            let px = draw_layers(layers, color, Some(&mut d[..]), threads, Some(clear));
+            let z: u32 = if opts.inv_w { 0 } else { u32::MAX };
+            let mut d = vec![z; len];
+            let px = draw_layers_cleared(layers, color, Some(&mut d[..]), threads, Some(clear), z);
             (DepthImage::U32(d), px)
         }
         DepthKind::None => {
@@ -418,6 +436,7 @@ mod tests {
             tile_width: 0,
             ids: true,
             mode: RasterMode::Clipping,
+            inv_w: false,
         }
     }
 

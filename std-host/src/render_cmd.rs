@@ -72,6 +72,7 @@ fn view_of(args: &RenderArgs) -> View {
         eye: args.eye,
         target: args.target,
         fov: args.fov,
+        inv_w: args.depth_kind == crate::cli::DepthKindArg::InvW,
     }
 }
 
@@ -106,6 +107,7 @@ fn load_source(args: &RenderArgs) -> Result<Scene, String> {
                 target,
                 fov,
                 args.aspect(),
+                view.inv_w,
             )
         }
         Source::ClipTris(path) => {
@@ -384,7 +386,28 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             crate::cli::ModeArg::Clipping => microraster::RasterMode::Clipping,
             crate::cli::ModeArg::Clipless => microraster::RasterMode::Clipless,
         },
+        inv_w: args.depth_kind == crate::cli::DepthKindArg::InvW,
     };
+    if opts.inv_w {
+        if args.depth == DepthArg::None {
+            return Err("--depth-kind inv-w needs a depth buffer (--depth u16 or u32)".to_string());
+        }
+        match args.source() {
+            Source::Scene(_) => {}
+            Source::Obj(_) => {
+                return Err(
+                    "--depth-kind inv-w is not yet supported with --obj (lit models); use --scene"
+                        .to_string(),
+                )
+            }
+            Source::ClipTris(_) => {
+                return Err(
+                    "--depth-kind inv-w needs a camera: --clip-tris gives its own clip-space z"
+                        .to_string(),
+                )
+            }
+        }
+    }
     let (r, load_warnings) = match args.source() {
         Source::Obj(_) if args.cull_clusters.is_some() => {
             return Err(

@@ -122,6 +122,9 @@ pub struct View {
     pub target: Option<[f32; 3]>,
     /// Vertical field of view in degrees.
     pub fov: Option<f32>,
+    /// 1/w depth: [`Mat4::perspective_inv_w`] (window depth `near / w`,
+    /// reversed, no far plane) instead of [`Mat4::perspective`].
+    pub inv_w: bool,
 }
 
 impl View {
@@ -133,7 +136,14 @@ impl View {
             eye: None,
             target: None,
             fov: None,
+            inv_w: false,
         }
+    }
+
+    /// The scene's projection: `near` and `far` as the scene chooses, the
+    /// far plane dropped for 1/w depth.
+    pub fn projection(&self, fov_y_radians: f32, near: f32, far: f32) -> Mat4 {
+        projection(self.inv_w, fov_y_radians, self.aspect(), near, far)
     }
 
     /// Width / height.
@@ -191,12 +201,7 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
     let eye = view.eye.unwrap_or(cubes::CUBES_EYE);
     let target = view.target.unwrap_or(cubes::CUBES_TARGET);
     let fov = view.fov.unwrap_or(cubes::CUBES_FOV_Y_DEG);
-    let proj = Mat4::perspective(
-        radians(fov),
-        view.aspect(),
-        cubes::CUBES_NEAR,
-        cubes::CUBES_FAR,
-    );
+    let proj = view.projection(radians(fov), cubes::CUBES_NEAR, cubes::CUBES_FAR);
     let view_proj = proj * look_at(eye, target)?;
     let mesh = &cubes::MESH;
     let colors = match mesh.attributes {
@@ -223,6 +228,16 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
 
 /// A mesh seen from `eye` towards `target`, flat-shaded with a head light
 /// (Lambert, per triangle, computed here on the host).
+/// [`Mat4::perspective`], or for 1/w depth (`inv_w`)
+/// [`Mat4::perspective_inv_w`] with the same near plane and none far.
+pub fn projection(inv_w: bool, fov_y_radians: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    if inv_w {
+        Mat4::perspective_inv_w(fov_y_radians, aspect, near)
+    } else {
+        Mat4::perspective(fov_y_radians, aspect, near, far)
+    }
+}
+
 pub fn mesh_scene(
     positions: &[[f32; 3]],
     indices: &[[u32; 3]],
@@ -230,6 +245,7 @@ pub fn mesh_scene(
     target: [f32; 3],
     fov_y_deg: f32,
     aspect: f32,
+    inv_w: bool,
 ) -> Result<Scene, String> {
     let view = look_at(eye, target)?;
     let positions: Vec<Vec3> = positions.iter().map(|&p| v3(p)).collect();
@@ -239,7 +255,7 @@ pub fn mesh_scene(
     let radius = bounds.map(|b| b.radius).unwrap_or(1.0);
     let near = (dist - 2.0 * radius).max(dist * 0.01).max(1e-4);
     let far = (dist + 2.0 * radius).max(near * 2.0);
-    let proj = Mat4::perspective(radians(fov_y_deg), aspect, near, far);
+    let proj = projection(inv_w, radians(fov_y_deg), aspect, near, far);
     let light = (eye - target).normalize();
     let colors = indices
         .iter()

@@ -533,6 +533,7 @@ mod tests {
             tile_width: 0,
             ids: true,
             mode: microraster::RasterMode::Clipping,
+            inv_w: false,
         }
     }
 

@@ -168,6 +168,85 @@ fn clipless_mode_renders_the_same_frame_for_any_split() {
     assert!(e.contains("tiles"), "{e}");
 }
 
+/// `--depth-kind inv-w`: 1/w depth, reversed (larger is nearer, cleared
+/// to 0), the same image as window z where no two surfaces are that close,
+/// the same outputs for any split, in both modes; errors where it cannot
+/// apply.
+#[test]
+fn inv_w_depth_kind() {
+    for mode in ["clipping", "clipless"] {
+        let base = outputs(
+            &format!("invw-{mode}-1"),
+            &[
+                "--mode",
+                mode,
+                "--depth-kind",
+                "inv-w",
+                "--depth",
+                "u32",
+                "--threads",
+                "1",
+            ],
+        );
+        let other = outputs(
+            &format!("invw-{mode}-2"),
+            &[
+                "--mode",
+                mode,
+                "--depth-kind",
+                "inv-w",
+                "--depth",
+                "u32",
+                "--threads",
+                "2",
+                "--strip-rows",
+                "5",
+            ],
+        );
+        assert!(base == other, "{mode}: the split changed the outputs");
+        let z = outputs(&format!("z-{mode}"), &["--mode", mode, "--depth", "u32"]);
+        let d = |b: &[u8]| -> Vec<u32> {
+            b.chunks_exact(4)
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect()
+        };
+        let (inv, zz) = (d(&base[2]), d(&z[2]));
+        // Background: 0 against the far plane's u32::MAX.
+        assert_eq!(
+            inv.iter().filter(|&&v| v == 0).count(),
+            zz.iter().filter(|&&v| v == u32::MAX).count()
+        );
+        // Nearer is larger: of any two drawn pixels, the order of 1/w is the
+        // reverse of the order of window z (ties aside).
+        let drawn: Vec<usize> = (0..inv.len())
+            .filter(|&i| inv[i] != 0)
+            .step_by(97)
+            .collect();
+        assert!(drawn.len() > 500);
+        for w in drawn.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if zz[a] < zz[b] {
+                assert!(inv[a] >= inv[b], "{mode}: pixels {a} {b}");
+            }
+        }
+    }
+    let o = tmp("invw.png");
+    let o = o.to_str().unwrap();
+    let e = fails(&[
+        "render",
+        "--depth-kind",
+        "inv-w",
+        "--depth",
+        "none",
+        "--out",
+        o,
+    ]);
+    assert!(e.contains("depth buffer"), "{e}");
+    let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
+    let e = fails(&["render", "--depth-kind", "inv-w", "--obj", spot, "--out", o]);
+    assert!(e.contains("--obj"), "{e}");
+}
+
 /// The colour, id and depth outputs of `render` with `extra` arguments.
 fn outputs(tag: &str, extra: &[&str]) -> [Vec<u8>; 3] {
     let (img, ids, depth) = (

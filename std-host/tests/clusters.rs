@@ -180,6 +180,7 @@ fn a_clustered_scene_renders_the_same_image_on_threads() {
         tile_width: 0,
         ids: false,
         mode: microraster::RasterMode::Clipping,
+        inv_w: false,
     };
     let want = render(&plain, &ro(1)).unwrap();
     for threads in [1, 2, 3] {

@@ -165,6 +165,7 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
         eye: args.eye,
         target: args.target,
         fov: args.fov,
+        inv_w: false,
     };
     let mut bs = match &args.obj {
         Some(path) => {
@@ -181,6 +182,7 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
                     target,
                     fov,
                     view.aspect(),
+                    view.inv_w,
                 )?,
                 spin: None,
             }
@@ -571,6 +573,7 @@ mod tests {
                 tile_width: 0,
                 ids: false,
                 mode: microraster::RasterMode::Clipping,
+                inv_w: false,
             };
             let want = render::render(&bs.scene, &opts).unwrap();
             let sum = format!("\"checksum\":\"{:016x}\"", want.checksum());

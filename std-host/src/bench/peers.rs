@@ -486,6 +486,7 @@ mod tests {
             tile_width: 0,
             ids: false,
             mode: microraster::RasterMode::Clipping,
+            inv_w: false,
         }
     }
 

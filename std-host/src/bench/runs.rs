@@ -359,6 +359,7 @@ fn render_fn_section(
         tile_width: s.tile_width,
         ids: false,
         mode: microraster::RasterMode::Clipping,
+        inv_w: false,
     };
     let (mut total, mut setup, mut raster) = (Vec::new(), Vec::new(), Vec::new());
     let mut checksum = 0;
