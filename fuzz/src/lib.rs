@@ -45,6 +45,7 @@
 #![forbid(unsafe_code)]
 
 pub mod big;
+pub mod clipless;
 pub mod clusters;
 mod drawer;
 pub mod shading;
