@@ -280,17 +280,6 @@ impl core::fmt::Display for Error {
 
 impl core::error::Error for Error {}
 
-/// Checks a row range and buffer sizes against a frame.
-pub(crate) fn check_rows(
-    config: &Config,
-    y0: u32,
-    y1: u32,
-    color_len: usize,
-    depth_len: Option<usize>,
-) -> Result<(), Error> {
-    check_rect(config, [0, config.width, y0, y1], color_len, depth_len)
-}
-
 /// Checks a rectangle `[x0, x1, y0, y1]` (columns `x0..x1`, rows `y0..y1`)
 /// and buffer sizes against a frame.
 pub(crate) fn check_rect(

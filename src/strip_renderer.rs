@@ -17,7 +17,7 @@
 //! be stored there).
 
 use crate::color::PixelFormat;
-use crate::config::{check_rows, check_size, Config, Error};
+use crate::config::{check_rect, check_size, Config, Error};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
@@ -137,6 +137,35 @@ impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32> StripRenderer<'b
     ) -> Result<Self, Error> {
         StripRenderer::with_shader(config, y0, y1, color, depth, VertexColor)
     }
+
+    /// A renderer for the rectangle `[x0, x1, y0, y1]` (columns `x0..x1`,
+    /// rows `y0..y1`) of a frame, drawing into `color` and `depth`, which
+    /// hold exactly that rectangle, row by row: a tile. Any split of a
+    /// frame into tiles gives the pixels of strips, in either mode.
+    ///
+    /// ```
+    /// use microraster::prelude::*;
+    /// use microraster::{Config, NoDepth, StripRenderer, Vec4};
+    ///
+    /// let mut tile = [Rgb888::BLACK; 4 * 4];
+    /// let mut no_depth = NoDepth;
+    /// // Columns 0..4 and rows 12..16 (bottom left) of a 16x16 frame.
+    /// let mut r =
+    ///     StripRenderer::<_, _, 8>::with_rect(Config::new(16, 16), [0, 4, 12, 16], &mut tile, &mut no_depth)
+    ///         .unwrap();
+    /// let v = |x, y| Vec4::new(x, y, 0.0, 1.0);
+    /// r.submit_clip_triangle([v(-1.0, -1.0), v(1.0, -1.0), v(-1.0, 1.0)], [Rgb888::RED; 3], 0)
+    ///     .unwrap();
+    /// assert_eq!(r.render_stats().pixels_written, 4 * 4);
+    /// ```
+    pub fn with_rect(
+        config: Config,
+        rect: [u32; 4],
+        color: &'b mut [C],
+        depth: &'b mut D,
+    ) -> Result<Self, Error> {
+        StripRenderer::with_shader_rect(config, rect, color, depth, VertexColor)
+    }
 }
 
 impl<'b, C: PixelFormat, D: DepthBuffer + ?Sized, const S: u32, const N: usize, F>
@@ -156,12 +185,24 @@ where
         depth: &'b mut D,
         fragment: F,
     ) -> Result<Self, Error> {
+        StripRenderer::with_shader_rect(config, [0, config.width, y0, y1], color, depth, fragment)
+    }
+
+    /// [`StripRenderer::with_rect`] with the fragment shader `fragment`.
+    pub fn with_shader_rect(
+        config: Config,
+        rect: [u32; 4],
+        color: &'b mut [C],
+        depth: &'b mut D,
+        fragment: F,
+    ) -> Result<Self, Error> {
         const { check_subpixel_bits::<S>() };
         check_size(&config)?;
         if config.mode == crate::config::RasterMode::Clipless && !cfg!(feature = "clipless") {
             return Err(Error::ModeUnsupported);
         }
-        check_rows(&config, y0, y1, color.len(), depth.depth_len())?;
+        check_rect(&config, rect, color.len(), depth.depth_len())?;
+        let [x0, x1, y0, y1] = rect;
         let whole = y0 == 0 && y1 == config.height;
         let h = config.height as f32;
         let slab = (!whole).then(|| {
@@ -174,9 +215,9 @@ where
             stage: Stage::new::<S>(config, slab),
             sink: StripSink {
                 strip: Strip {
-                    width: config.width as usize,
-                    x0: 0,
-                    x1: config.width,
+                    width: (x1 - x0) as usize,
+                    x0,
+                    x1,
                     y0,
                     y1,
                     color,

@@ -551,6 +551,70 @@ fn any_strip_height_gives_the_same_frame() {
     }
 }
 
+/// Tiles ([`StripRenderer::with_rect`]) of any size give the frame of
+/// strips, colours and depth, in both modes.
+#[test]
+fn any_tile_size_gives_the_same_frame() {
+    let mut rng = common::SplitMix(19);
+    let (w, h) = (45u32, 34u32);
+    let mut tris = vec![];
+    for k in 0..30 {
+        let mut c = || rng.range(-1.4, 1.4) as f32;
+        let ww = if k % 6 == 0 { -0.4 } else { 1.0 };
+        tris.push([
+            v(c(), c(), c() * 0.9, 1.0),
+            v(c(), c(), c() * 0.9, 1.2),
+            v(c(), c(), c(), ww),
+        ]);
+    }
+    let colors = [
+        Rgb888::new(250, 10, 10),
+        Rgb888::new(10, 250, 10),
+        Rgb888::new(10, 10, 250),
+    ];
+    for mode in [RasterMode::Clipping, RasterMode::Clipless] {
+        let mut config = Config::new(w, h);
+        config.cull = CullMode::None;
+        config.mode = mode;
+        let draw = |tw: u32, th: u32| {
+            let mut px = vec![Rgb888::BLACK; (w * h) as usize];
+            let mut dz = vec![u32::MAX; (w * h) as usize];
+            for ty in (0..h).step_by(th as usize) {
+                for tx in (0..w).step_by(tw as usize) {
+                    let (x1, y1) = ((tx + tw).min(w), (ty + th).min(h));
+                    let n = ((x1 - tx) * (y1 - ty)) as usize;
+                    let (mut p, mut d) = (vec![Rgb888::BLACK; n], vec![u32::MAX; n]);
+                    let mut r = StripRenderer::<_, _, 8>::with_rect(
+                        config,
+                        [tx, x1, ty, y1],
+                        &mut p,
+                        &mut d[..],
+                    )
+                    .unwrap();
+                    for (i, t) in tris.iter().enumerate() {
+                        let col = if i % 3 == 0 { [colors[1]; 3] } else { colors };
+                        r.submit_clip_triangle(*t, col, i as u32).unwrap();
+                    }
+                    for (k, (pp, dd)) in p.iter().zip(&d).enumerate() {
+                        let (x, y) = (tx + k as u32 % (x1 - tx), ty + k as u32 / (x1 - tx));
+                        px[(y * w + x) as usize] = *pp;
+                        dz[(y * w + x) as usize] = *dd;
+                    }
+                }
+            }
+            (px, dz)
+        };
+        let strips = draw(w, h);
+        assert!(strips.0.iter().filter(|&&p| p != Rgb888::BLACK).count() > 400);
+        for (tw, th) in [(1, 1), (7, 5), (16, 16), (32, 8), (45, 3)] {
+            assert!(
+                draw(tw, th) == strips,
+                "{mode:?}: tiles of {tw}x{th} differ"
+            );
+        }
+    }
+}
+
 /// On a scene wholly in front of the eye the two modes differ only where
 /// their quantizations do: pixel centres within a hair of an edge.
 #[test]

@@ -263,7 +263,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "BITS", default_value = "8", value_parser = parse_subpixel)]
     pub subpixel: u32,
 
-    /// Rasterization mode (clipless: no --tile, no --obj).
+    /// Rasterization mode (clipless: not with --obj).
     #[arg(long, value_enum, default_value_t = ModeArg::Clipping)]
     pub mode: ModeArg,
 

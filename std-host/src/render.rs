@@ -13,7 +13,7 @@
 //! byte-identical for any thread count and any strip height.
 
 use crate::pipeline::{
-    draw_layers, draw_layers_cleared, fill, for_each_strip, FramePipeline, Layer,
+    draw_layers, draw_layers_cleared, fill, for_each_tile, FramePipeline, Layer,
 };
 use crate::scene::Scene;
 use microraster::pixelcolor::{Rgb888, RgbColor};
@@ -251,15 +251,12 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
 }
 
 /// The clipless mode: no frame stores set-up triangles
-/// ([`Frame`](microraster::Frame) refuses the mode), so every strip, on
-/// the threads, draws the whole scene with a
+/// ([`Frame`](microraster::Frame) refuses the mode), so every strip (or
+/// tile), on the threads, draws the whole scene with a
 /// [`StripRenderer`](microraster::StripRenderer), from vertices processed
 /// once per frame. The counters are summed over the strips (each one sets
 /// up the triangles that reach it).
 fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
-    if opts.tile_width > 0 && opts.tile_width < opts.width {
-        return Err("--mode clipless draws strips, not tiles: drop --tile".to_string());
-    }
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
@@ -294,67 +291,66 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
     let pieces = crate::pipeline::partition(scene, 1).concat();
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let stats = std::sync::Mutex::new(Stats::default());
-    let draw =
-        |color: &mut [Rgb888], ids: Option<&mut [TriangleId]>, depth: DepthKind, count: bool| {
-            macro_rules! strips {
-                ($c:expr, $clear:expr, $d:expr) => {
-                    for_each_strip($c, $d, w as usize, rows as usize, threads, |y0, c, d| {
-                        c.fill($clear);
-                        let y1 = y0 + (c.len() / w as usize) as u32;
-                        let (written, st) = match d {
-                            Some(d) => {
-                                d.fill(if reversed {
-                                    DepthWord::from_z32(0)
-                                } else {
-                                    DepthWord::FAR
-                                });
-                                let mut r = StripRenderer::<_, _, S>::with_subpixel_bits(
-                                    config, y0, y1, c, d,
-                                )?;
-                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
-                                (r.render_stats().pixels_written, r.stats())
-                            }
-                            None => {
-                                let mut none = NoDepth;
-                                let mut r = StripRenderer::<_, _, S>::with_subpixel_bits(
-                                    config, y0, y1, c, &mut none,
-                                )?;
-                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
-                                (r.render_stats().pixels_written, r.stats())
-                            }
-                        };
-                        if count {
-                            if let Ok(mut s) = stats.lock() {
-                                *s += st;
-                            }
+    let tile = (opts.tile_width as usize, rows as usize);
+    let draw = |color: &mut [Rgb888],
+                ids: Option<&mut [TriangleId]>,
+                depth: DepthKind,
+                count: bool| {
+        macro_rules! strips {
+            ($c:expr, $clear:expr, $d:expr) => {
+                for_each_tile($c, $d, w as usize, tile, threads, false, |_, rect, c, d| {
+                    c.fill($clear);
+                    let (written, st) = match d {
+                        Some(d) => {
+                            d.fill(if reversed {
+                                DepthWord::from_z32(0)
+                            } else {
+                                DepthWord::FAR
+                            });
+                            let mut r = StripRenderer::<_, _, S>::with_rect(config, rect, c, d)?;
+                            fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                            (r.render_stats().pixels_written, r.stats())
                         }
-                        Ok(written)
-                    })
-                };
-            }
-            macro_rules! kinds {
-                ($c:expr, $clear:expr) => {
-                    match depth {
-                        DepthKind::U16 => {
-                            let mut d = vec![if reversed { 0 } else { u16::MAX }; len];
-                            strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U16(d), px))
+                        None => {
+                            let mut none = NoDepth;
+                            let mut r =
+                                StripRenderer::<_, _, S>::with_rect(config, rect, c, &mut none)?;
+                            fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                            (r.render_stats().pixels_written, r.stats())
                         }
-                        DepthKind::U32 => {
-                            let mut d = vec![if reversed { 0 } else { u32::MAX }; len];
-                            strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U32(d), px))
-                        }
-                        DepthKind::None => {
-                            strips!($c, $clear, None::<&mut [u32]>).map(|px| (DepthImage::None, px))
+                    };
+                    if count {
+                        if let Ok(mut s) = stats.lock() {
+                            *s += st;
                         }
                     }
-                };
-            }
-            match ids {
-                Some(ids) => kinds!(ids, TriangleId(0)),
-                None => kinds!(color, BACKGROUND),
-            }
-            .map_err(|e| e.to_string())
-        };
+                    Ok(written)
+                })
+            };
+        }
+        macro_rules! kinds {
+            ($c:expr, $clear:expr) => {
+                match depth {
+                    DepthKind::U16 => {
+                        let mut d = vec![if reversed { 0 } else { u16::MAX }; len];
+                        strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U16(d), px))
+                    }
+                    DepthKind::U32 => {
+                        let mut d = vec![if reversed { 0 } else { u32::MAX }; len];
+                        strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U32(d), px))
+                    }
+                    DepthKind::None => {
+                        strips!($c, $clear, None::<&mut [u32]>).map(|px| (DepthImage::None, px))
+                    }
+                }
+            };
+        }
+        match ids {
+            Some(ids) => kinds!(ids, TriangleId(0)),
+            None => kinds!(color, BACKGROUND),
+        }
+        .map_err(|e| e.to_string())
+    };
     let mut color = vec![BACKGROUND; len];
     let t1 = Instant::now();
     let (depth, pixels_written) = draw(&mut color, None, opts.depth, true)?;

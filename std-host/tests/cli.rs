@@ -156,16 +156,14 @@ fn clipless_mode_renders_the_same_frame_for_any_split() {
         tmp("c.png").to_str().unwrap(),
     ]);
     assert!(e.contains("clipless"), "{e}");
-    let e = fails(&[
-        "render",
-        "--mode",
-        "clipless",
-        "--tile",
-        "32x32",
-        "--out",
-        tmp("c.png").to_str().unwrap(),
-    ]);
-    assert!(e.contains("tiles"), "{e}");
+    let strips = outputs("clipless-strips", &["--mode", "clipless", "--threads", "2"]);
+    for tile in ["32x32", "7x5", "800x3"] {
+        let tiles = outputs(
+            &format!("clipless-tile-{tile}"),
+            &["--mode", "clipless", "--tile", tile, "--threads", "2"],
+        );
+        assert!(tiles == strips, "tiles of {tile} differ");
+    }
 }
 
 /// `--depth-kind inv-w`: 1/w depth, reversed (larger is nearer, cleared
