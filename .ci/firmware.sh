@@ -369,6 +369,12 @@ for b in "thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit"; do
   check_ram "$board" clipless || failed=1
   clipless_rows+=("| $board | clipless | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
   check_counts "$board" clipless "$frame $display $render $clears $geometry $raster" || failed=1
+  # The report's mode axis: this run and the immediate build's above.
+  check_config "$board" "S8 u16 libm clipless" "$frame $render $raster" || failed=1
+  if [ -f "$log/$board-immediate.txt" ]; then
+    parse_run "$log/$board-immediate.txt"
+    check_config "$board" "S8 u16 libm immediate" "$frame $render $raster" || failed=1
+  fi
 done
 cd "$root"
 

@@ -19,6 +19,18 @@ pub struct Tolerance {
 }
 
 impl Tolerance {
+    /// The clipless mode's: its quantization moves a vertex by at most
+    /// `D 2^-21` pixels (`D` the frame's larger side, 22-bit mantissas of
+    /// coordinates up to `2 w D`) and its window depth by `2^-21`, plus the
+    /// measured vertex error.
+    pub fn clipless(width: u32, height: u32, v: &VertexError) -> Self {
+        let d = width.max(height) as f64;
+        Tolerance {
+            xy: std::f64::consts::SQRT_2 * (d * 2f64.powi(-21) + v.window_px) + 1e-6,
+            z: v.window_z + 2f64.powi(-21) + 1e-9,
+        }
+    }
+
     /// Half a subpixel per axis (√2 of that as a distance), plus the
     /// measured vertex error, plus a little slack for `f64` rounding.
     pub fn new(subpixel: u32, v: &VertexError) -> Self {

@@ -1,9 +1,12 @@
 //! The core's side of the report: one frame per configuration, timed.
 //!
-//! Design note: each of the eight configurations is a distinct
+//! Design note: each configuration of the grid is a distinct
 //! monomorphisation (sub-pixel bits and depth word are const and type
 //! parameters); [`runner`] erases them behind one trait object, so the sweep
-//! is a plain loop. Buffers are allocated before the clock starts.
+//! is a plain loop. Buffers are allocated before the clock starts, except
+//! what only the variants use: the tile bins and tile buffers, and the
+//! immediate mode's vertex caches, are allocated inside each frame (part
+//! of their cost here).
 
 use super::*;
 use microraster::prelude::Submit;
@@ -59,9 +62,11 @@ pub(crate) struct CoreInput<'a> {
     pub(crate) height: u32,
 }
 
-/// One whole frame: matrices, setup, clear, all rows.
+/// One whole frame: matrices, setup, clear, all rows, as `variant` says
+/// (1/w depth where the scene's camera asks for it).
 pub(crate) fn frame_once<const S: u32, C, T>(
     input: &CoreInput<'_>,
+    variant: Variant,
     storage: &mut [SetupTriangle],
     color: &mut [C],
     clear: C,
@@ -74,15 +79,100 @@ where
 {
     let (w, h) = (input.width, input.height);
     let mvps = mvps(input.spec, input.math, w, h);
-    let mut frame = Frame::<S>::with_subpixel_bits(Config::new(w, h), storage)?;
+    let mut config = Config::new(w, h);
+    let far = if input.spec.camera.inv_w {
+        config.depth_func = microraster::DepthFunc::Greater;
+        T::from_z32(0)
+    } else {
+        T::FAR
+    };
+    color.fill(clear);
+    depth.fill(far);
+    if variant == Variant::Clipless {
+        config.mode = microraster::RasterMode::Clipless;
+    }
+    if matches!(variant, Variant::Clipless | Variant::Immediate) {
+        return immediate_frame::<S, C, T>(input, config, &mvps, color, depth);
+    }
+    let mut frame = Frame::<S>::with_subpixel_bits(config, storage)?;
     let mut id = 0u32;
     for (o, m) in input.objects.iter().zip(&mvps) {
         frame.submit_mesh(&o.mesh(), m, id)?;
         id = id.wrapping_add(o.indices.len() as u32);
     }
-    color.fill(clear);
-    depth.fill(T::FAR);
-    frame.render_rows(0, h, color, depth)?;
+    let Variant::Tiles(n) = variant else {
+        frame.render_rows(0, h, color, depth)?;
+        return Ok(());
+    };
+    let mut offsets = vec![0u32; frame.tiles(n, n) + 1];
+    let mut items = vec![0u32; frame.tile_bin_entries(n, n)];
+    let bins = frame.bin_tiles(n, n, &mut offsets, &mut items)?;
+    let side = n as usize;
+    let (mut tc, mut td) = (vec![clear; side * side], vec![far; side * side]);
+    for t in 0..frame.tiles(n, n) as u32 {
+        let [x0, x1, y0, y1] = bins.rect(t);
+        let tw = (x1 - x0) as usize;
+        let len = tw * (y1 - y0) as usize;
+        tc[..len].fill(clear);
+        td[..len].fill(far);
+        frame.render_tile(&bins, t, &mut tc[..len], &mut td[..len])?;
+        for (r, y) in (y0..y1).enumerate() {
+            let at = y as usize * w as usize + x0 as usize;
+            color[at..at + tw].copy_from_slice(&tc[r * tw..(r + 1) * tw]);
+            depth[at..at + tw].copy_from_slice(&td[r * tw..(r + 1) * tw]);
+        }
+    }
+    Ok(())
+}
+
+/// An immediate-mode frame (either mode): the vertex stage once, then
+/// every strip of [`CLIPLESS_STRIP_ROWS`] rows drawn by a strip renderer
+/// that submits the scene again (the triangles outside the strip are
+/// skipped before setup).
+fn immediate_frame<const S: u32, C, T>(
+    input: &CoreInput<'_>,
+    config: Config,
+    mvps: &[microraster::Mat4],
+    color: &mut [C],
+    depth: &mut [T],
+) -> Result<(), Error>
+where
+    C: microraster::PixelFormat,
+    T: DepthWord + Into<u64>,
+    [T]: DepthBuffer,
+{
+    let w = input.width as usize;
+    let mut row = vec![TriangleId(0); w];
+    let mut none = microraster::NoDepth;
+    let probe = microraster::StripRenderer::<_, _, S>::with_subpixel_bits(
+        config, 0, 1, &mut row, &mut none,
+    )?;
+    let caches: Vec<Vec<microraster::ProcessedVertex>> = input
+        .objects
+        .iter()
+        .zip(mvps)
+        .map(|(o, m)| {
+            let mut c = vec![microraster::ProcessedVertex::EMPTY; o.positions.len()];
+            probe.process_vertices(m, &o.positions, &mut c);
+            c
+        })
+        .collect();
+    let chunk = w * CLIPLESS_STRIP_ROWS as usize;
+    for (k, (c, d)) in color
+        .chunks_mut(chunk)
+        .zip(depth.chunks_mut(chunk))
+        .enumerate()
+    {
+        let y0 = k as u32 * CLIPLESS_STRIP_ROWS;
+        let y1 = y0 + (c.len() / w) as u32;
+        let mut r =
+            microraster::StripRenderer::<C, [T], S>::with_subpixel_bits(config, y0, y1, c, d)?;
+        let mut id = 0u32;
+        for (o, cache) in input.objects.iter().zip(&caches) {
+            r.submit_processed_mesh(&o.mesh(), id, cache)?;
+            id = id.wrapping_add(o.indices.len() as u32);
+        }
+    }
     Ok(())
 }
 
@@ -98,6 +188,7 @@ pub(crate) trait Runner {
 
 pub(crate) struct TypedRunner<'a, const S: u32, T> {
     pub(crate) input: CoreInput<'a>,
+    pub(crate) variant: Variant,
     pub(crate) storage: Vec<SetupTriangle>,
     pub(crate) color: Vec<Rgb888>,
     pub(crate) depth: Vec<T>,
@@ -110,11 +201,12 @@ where
 {
     /// Allocates everything and renders one frame to warm up (growing the
     /// setup storage until the frame fits).
-    fn new(input: CoreInput<'a>) -> Result<Self, String> {
+    fn new(input: CoreInput<'a>, variant: Variant) -> Result<Self, String> {
         let len = input.width as usize * input.height as usize;
         let n: usize = input.objects.iter().map(|o| o.indices.len()).sum();
         let mut r = TypedRunner {
             input,
+            variant,
             storage: vec![SetupTriangle::EMPTY; Frame::<8>::storage_for(n)],
             color: vec![Rgb888::BLACK; len],
             depth: vec![T::FAR; len],
@@ -122,6 +214,7 @@ where
         loop {
             match frame_once::<S, _, T>(
                 &r.input,
+                r.variant,
                 &mut r.storage,
                 &mut r.color,
                 Rgb888::BLACK,
@@ -148,6 +241,7 @@ where
         let t = Instant::now();
         frame_once::<S, _, T>(
             &self.input,
+            self.variant,
             &mut self.storage,
             &mut self.color,
             Rgb888::BLACK,
@@ -161,9 +255,10 @@ where
     fn finish(&mut self) -> Result<CoreRun, String> {
         let len = self.color.len();
         let mut ids = vec![TriangleId(0); len];
-        let mut id_depth = vec![T::FAR; len];
+        let mut id_depth = self.depth.clone();
         frame_once::<S, _, T>(
             &self.input,
+            self.variant,
             &mut self.storage,
             &mut ids,
             TriangleId(0),
@@ -183,11 +278,12 @@ pub(crate) fn runner<'a>(
     input: CoreInput<'a>,
     c: Configuration,
 ) -> Result<Box<dyn Runner + 'a>, String> {
+    let v = c.variant;
     Ok(match (c.subpixel, c.depth_bits) {
-        (4, 16) => Box::new(TypedRunner::<4, u16>::new(input)?),
-        (4, 32) => Box::new(TypedRunner::<4, u32>::new(input)?),
-        (8, 16) => Box::new(TypedRunner::<8, u16>::new(input)?),
-        (8, 32) => Box::new(TypedRunner::<8, u32>::new(input)?),
+        (4, 16) => Box::new(TypedRunner::<4, u16>::new(input, v)?),
+        (4, 32) => Box::new(TypedRunner::<4, u32>::new(input, v)?),
+        (8, 16) => Box::new(TypedRunner::<8, u16>::new(input, v)?),
+        (8, 32) => Box::new(TypedRunner::<8, u32>::new(input, v)?),
         (s, d) => return Err(format!("unsupported configuration S={s} depth u{d}")),
     })
 }

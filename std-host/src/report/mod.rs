@@ -3,7 +3,10 @@
 //!
 //! Design note: the report sweeps the eight compile-time configurations of
 //! the core (subpixel bits 4 / 8, depth `u16` / `u32`, matrices built with
-//! `libm` / `micromath`) over four scenes (the four cubes, Spot, the teapot
+//! `libm` / `micromath`), and on `S8 libm` the run-time choices of issue
+//! 12 ([`Variant`]: immediate mode, the clipless mode, 1/w depth, tiles of
+//! 16, 32 and 64 pixels; the 1/w configurations are measured against a
+//! reference drawn with the same projection and depth test), over four scenes (the four cubes, Spot, the teapot
 //! and the Stanford bunny from `assets/models/`), every one with per-vertex
 //! colours from its normals so that Gouraud interpolation is exercised.
 //!
@@ -120,36 +123,77 @@ impl MathBackend {
     }
 }
 
-/// One compile-time configuration of the core.
+/// The run-time choices beyond the compile-time grid (issue 12's axes):
+/// the rasterization mode, what the depth buffer holds, strips or tiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Variant {
+    /// The clipping mode, window z, set up once, drawn as one strip.
+    Base,
+    /// The clipping mode in immediate mode: strips of
+    /// [`CLIPLESS_STRIP_ROWS`] rows by strip renderers, as the clipless
+    /// mode draws (its fair comparison).
+    Immediate,
+    /// The clipless mode (`RasterMode::Clipless`), drawn in strips of
+    /// [`CLIPLESS_STRIP_ROWS`] rows by strip renderers (a frame cannot
+    /// store clipless triangles), from vertices processed once.
+    Clipless,
+    /// 1/w depth (`Mat4::perspective_inv_w`, depth test `Greater`).
+    InvW,
+    /// Set up once, binned into tiles of `n x n` pixels, each drawn into
+    /// its own buffers and copied into the frame.
+    Tiles(u32),
+}
+
+/// Rows per strip of the clipless runs (the firmware draws 15).
+pub const CLIPLESS_STRIP_ROWS: u32 = 16;
+
+/// One configuration of the core: the compile-time grid (subpixel bits,
+/// depth word, float backend) and a [`Variant`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Configuration {
-    /// Subpixel bits: 4 or 8.
+    /// Subpixel bits: 4 or 8 (unused by the clipless mode).
     pub subpixel: u32,
     /// Depth buffer bits: 16 or 32.
     pub depth_bits: u32,
     /// Float backend of the matrices.
     pub math: MathBackend,
+    /// Mode, depth kind, tiles.
+    pub variant: Variant,
 }
 
 impl Configuration {
-    /// A short name, e.g. `S8 u16 libm`.
+    /// A short name, e.g. `S8 u16 libm`, `S8 u16 libm clipless`, `S8 u16
+    /// libm tiles 32x32`.
     pub fn label(&self) -> String {
-        format!(
+        let base = format!(
             "S{} u{} {}",
             self.subpixel,
             self.depth_bits,
             self.math.name()
-        )
+        );
+        match self.variant {
+            Variant::Base => base,
+            Variant::Immediate => format!("{base} immediate"),
+            Variant::Clipless => format!("{base} clipless"),
+            Variant::InvW => format!("{base} inv-w"),
+            Variant::Tiles(n) => format!("{base} tiles {n}x{n}"),
+        }
     }
 }
 
-/// Every configuration the report compares.
-pub const CONFIGURATIONS: [Configuration; 8] = {
-    let mut out = [Configuration {
-        subpixel: 8,
-        depth_bits: 16,
+const fn config(subpixel: u32, depth_bits: u32, variant: Variant) -> Configuration {
+    Configuration {
+        subpixel,
+        depth_bits,
         math: MathBackend::Libm,
-    }; 8];
+        variant,
+    }
+}
+
+/// Every configuration the report compares: the grid of eight, then the
+/// variants on `S8 libm`.
+pub const CONFIGURATIONS: [Configuration; 16] = {
+    let mut out = [config(8, 16, Variant::Base); 16];
     let mut i = 0;
     while i < 8 {
         out[i] = Configuration {
@@ -160,9 +204,18 @@ pub const CONFIGURATIONS: [Configuration; 8] = {
             } else {
                 MathBackend::Micromath
             },
+            variant: Variant::Base,
         };
         i += 1;
     }
+    out[8] = config(8, 16, Variant::Immediate);
+    out[9] = config(8, 16, Variant::Clipless);
+    out[10] = config(8, 32, Variant::Clipless);
+    out[11] = config(8, 16, Variant::InvW);
+    out[12] = config(8, 32, Variant::InvW);
+    out[13] = config(8, 16, Variant::Tiles(16));
+    out[14] = config(8, 16, Variant::Tiles(32));
+    out[15] = config(8, 16, Variant::Tiles(64));
     out
 };
 
@@ -338,6 +391,74 @@ pub fn load_scene(name: &str, models: &Path, aspect: f32) -> Result<SceneSpec, S
     Ok(mesh_spec(name, &mesh, aspect))
 }
 
+/// A scene, the same scene with 1/w depth, and the `f64` reference of
+/// each: what every configuration is measured against.
+pub struct SceneRefs {
+    spec: SceneSpec,
+    spec_inv: SceneSpec,
+    refs: [(RefImage, Vec<Option<Prepared>>); 2],
+}
+
+impl SceneRefs {
+    /// Renders both references of `spec` at `width x height`.
+    pub fn new(spec: SceneSpec, width: u32, height: u32) -> SceneRefs {
+        let mut spec_inv = spec.clone();
+        spec_inv.camera.inv_w = true;
+        let refs = [&spec, &spec_inv].map(|s| {
+            let tris = reference_triangles(s, width, height);
+            let reference = reference::render_reference(
+                &tris,
+                &RefOptions {
+                    width,
+                    height,
+                    cull: CullMode::Back,
+                    front_face: FrontFace::Ccw,
+                    greater: s.camera.inv_w,
+                },
+            );
+            let prepared = tris
+                .iter()
+                .map(|t| Prepared::new(t, width, height))
+                .collect();
+            (reference, prepared)
+        });
+        SceneRefs {
+            spec,
+            spec_inv,
+            refs,
+        }
+    }
+
+    /// The scene configuration `c` draws (1/w depth or not).
+    pub fn spec(&self, c: &Configuration) -> &SceneSpec {
+        if c.variant == Variant::InvW {
+            &self.spec_inv
+        } else {
+            &self.spec
+        }
+    }
+
+    /// The errors of `run`, drawn in configuration `c`, against the
+    /// reference, with the tolerance of its mode, and its vertex error.
+    pub(crate) fn errors(
+        &self,
+        c: &Configuration,
+        run: &CoreRun,
+        width: u32,
+        height: u32,
+    ) -> (ErrorStats, VertexError) {
+        let s = self.spec(c);
+        let vertex = vertex_error(s, &mvps(s, c.math, width, height), width, height);
+        let (reference, prepared) = &self.refs[s.camera.inv_w as usize];
+        let tolerance = match c.variant {
+            Variant::Clipless => Tolerance::clipless(width, height, &vertex),
+            _ => Tolerance::new(c.subpixel, &vertex),
+        };
+        let errors = compare(run, c.depth_bits, reference, prepared, tolerance);
+        (errors, vertex)
+    }
+}
+
 fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
     let (width, height) = args
         .size
@@ -366,27 +487,17 @@ fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
     let mut rows = Vec::new();
     for name in &names {
         bar.set_message(format!("{name}: loading, f64 reference"));
-        let spec = load_scene(name, &models, width as f32 / height as f32)?;
-        let tris = reference_triangles(&spec, width, height);
-        let reference = reference::render_reference(
-            &tris,
-            &RefOptions {
-                width,
-                height,
-                cull: CullMode::Back,
-                front_face: FrontFace::Ccw,
-            },
+        let scene = SceneRefs::new(
+            load_scene(name, &models, width as f32 / height as f32)?,
+            width,
+            height,
         );
-        let prepared: Vec<Option<Prepared>> = tris
-            .iter()
-            .map(|t| Prepared::new(t, width, height))
-            .collect();
-        let objects: Vec<CoreObject> = spec.objects.iter().map(CoreObject::new).collect();
+        let objects: Vec<CoreObject> = scene.spec.objects.iter().map(CoreObject::new).collect();
         bar.inc(1);
         let mut runners = Vec::new();
         for config in CONFIGURATIONS {
             let input = CoreInput {
-                spec: &spec,
+                spec: scene.spec(&config),
                 objects: &objects,
                 math: config.math,
                 width,
@@ -405,19 +516,7 @@ fn speed_vs_error(args: &ReportArgs) -> Result<(), String> {
         for ((config, r), t) in CONFIGURATIONS.iter().zip(&mut runners).zip(&times) {
             bar.set_message(format!("{name}: {} against f64", config.label()));
             let run = r.finish()?;
-            let vertex = vertex_error(
-                &spec,
-                &mvps(&spec, config.math, width, height),
-                width,
-                height,
-            );
-            let errors = compare(
-                &run,
-                config.depth_bits,
-                &reference,
-                &prepared,
-                Tolerance::new(config.subpixel, &vertex),
-            );
+            let (errors, vertex) = scene.errors(config, &run, width, height);
             rows.push(Row {
                 scene: name.clone(),
                 config: *config,
@@ -517,12 +616,23 @@ mod tests {
     #[test]
     fn configurations_cover_the_grid_once() {
         let mut seen = std::collections::HashSet::new();
+        let mut labels = std::collections::HashSet::new();
         for c in CONFIGURATIONS {
             assert!(seen.insert(c));
+            assert!(labels.insert(c.label()));
             assert!(matches!(c.subpixel, 4 | 8));
             assert!(matches!(c.depth_bits, 16 | 32));
         }
-        assert_eq!(seen.len(), 8);
+        let grid = CONFIGURATIONS.iter().filter(|c| c.variant == Variant::Base);
+        assert_eq!(grid.count(), 8);
+        for v in [
+            Variant::Immediate,
+            Variant::Clipless,
+            Variant::InvW,
+            Variant::Tiles(32),
+        ] {
+            assert!(CONFIGURATIONS.iter().any(|c| c.variant == v), "{v:?}");
+        }
     }
 
     #[test]
@@ -533,40 +643,36 @@ mod tests {
 
     #[test]
     fn cubes_match_the_reference_up_to_snapping() {
-        let spec = cubes_spec();
         let (w, h) = (96, 72);
-        let tris = reference_triangles(&spec, w, h);
-        let reference = reference::render_reference(
-            &tris,
-            &RefOptions {
-                width: w,
-                height: h,
-                cull: CullMode::Back,
-                front_face: FrontFace::Ccw,
-            },
-        );
-        let prepared: Vec<_> = tris.iter().map(|t| Prepared::new(t, w, h)).collect();
-        let objects: Vec<CoreObject> = spec.objects.iter().map(CoreObject::new).collect();
+        let scene = SceneRefs::new(cubes_spec(), w, h);
+        let objects: Vec<CoreObject> = scene.spec.objects.iter().map(CoreObject::new).collect();
+        let mut frames = std::collections::HashMap::new();
         for config in CONFIGURATIONS {
             let input = CoreInput {
-                spec: &spec,
+                spec: scene.spec(&config),
                 objects: &objects,
                 math: config.math,
                 width: w,
                 height: h,
             };
             let run = runner(input, config).unwrap().finish().unwrap();
-            let v = vertex_error(&spec, &mvps(&spec, config.math, w, h), w, h);
+            let (e, v) = scene.errors(&config, &run, w, h);
             if config.math == MathBackend::Libm {
                 assert!(v.window_px < 1e-3, "{config:?} {v:?}");
             }
-            let e = compare(
-                &run,
-                config.depth_bits,
-                &reference,
-                &prepared,
-                Tolerance::new(config.subpixel, &v),
-            );
+            // Tiles and immediate mode draw the frame of strips, bit for
+            // bit.
+            if matches!(
+                config.variant,
+                Variant::Base | Variant::Tiles(_) | Variant::Immediate
+            ) {
+                let key = (config.subpixel, config.depth_bits, config.math);
+                let frame = (run.ids.clone(), run.color.clone(), run.depth.clone());
+                assert!(
+                    *frames.entry(key).or_insert_with(|| frame.clone()) == frame,
+                    "{config:?}"
+                );
+            }
             assert!(e.covered > 1000);
             assert_eq!(e.unexplained, 0, "{config:?} {e:?}");
             assert_eq!(e.depth_beyond, 0, "{config:?} {e:?}");
@@ -595,7 +701,8 @@ mod tests {
         run(&args).unwrap();
         let md = std::fs::read_to_string(dir.path().join("out/speed-vs-error.md")).unwrap();
         assert!(md.contains("S8 u16 libm"));
-        assert_eq!(md.matches("| cubes |").count(), 8);
+        assert!(md.contains("S8 u16 libm clipless"));
+        assert_eq!(md.matches("| cubes |").count(), CONFIGURATIONS.len());
         let png = std::fs::read(dir.path().join("out/speed-vs-error.png")).unwrap();
         assert_eq!(&png[1..4], b"PNG");
     }

@@ -59,6 +59,8 @@ pub struct RefOptions {
     pub cull: CullMode,
     /// Front-face winding.
     pub front_face: FrontFace,
+    /// Depth test `Greater` from 0 (1/w depth) instead of `Less` from 1.
+    pub greater: bool,
 }
 
 /// What the reference renderer drew.
@@ -281,7 +283,7 @@ pub fn render_reference(tris: &[RefTriangle], opts: &RefOptions) -> RefImage {
         width: w,
         height: h,
         ids: vec![0; len],
-        depth: vec![1.0; len],
+        depth: vec![if opts.greater { 0.0 } else { 1.0 }; len],
         color: vec![[0.0; 3]; len],
         source: vec![None; len],
     };
@@ -302,7 +304,12 @@ pub fn render_reference(tris: &[RefTriangle], opts: &RefOptions) -> RefImage {
             for px in x0..=x1 {
                 let s = p.sample(px as f64 + 0.5, py as f64 + 0.5);
                 let i = py as usize * w as usize + px as usize;
-                if s.inside && s.depth < img.depth[i] {
+                let nearer = if opts.greater {
+                    s.depth > img.depth[i]
+                } else {
+                    s.depth < img.depth[i]
+                };
+                if s.inside && nearer {
                     img.depth[i] = s.depth;
                     img.color[i] = s.color;
                     img.ids[i] = t.id.wrapping_add(1);
@@ -398,6 +405,17 @@ pub mod mat {
         ]
     }
 
+    /// The core's `Mat4::perspective_inv_w`: window depth `near / w`.
+    pub fn perspective_inv_w(fov_y_rad: f64, aspect: f64, near: f64) -> DMat4 {
+        let f = 1.0 / (fov_y_rad * 0.5).tan();
+        [
+            [f / aspect, 0.0, 0.0, 0.0],
+            [0.0, f, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 2.0 * near],
+            [0.0, 0.0, -1.0, 0.0],
+        ]
+    }
+
     fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
     }
@@ -438,6 +456,7 @@ mod tests {
             height: h,
             cull,
             front_face: FrontFace::Ccw,
+            greater: false,
         }
     }
 

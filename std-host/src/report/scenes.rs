@@ -25,6 +25,9 @@ pub struct Camera {
     pub near: f32,
     /// Far plane distance.
     pub far: f32,
+    /// 1/w depth: `Mat4::perspective_inv_w` (no far plane) instead of
+    /// `Mat4::perspective`.
+    pub inv_w: bool,
 }
 
 /// One mesh of a scene, with the model transform applied to it.
@@ -120,6 +123,7 @@ pub fn cubes_spec() -> SceneSpec {
             fov_y_deg: cubes::CUBES_FOV_Y_DEG,
             near: cubes::CUBES_NEAR,
             far: cubes::CUBES_FAR,
+            inv_w: false,
         },
     }
 }
@@ -159,6 +163,7 @@ pub fn mesh_spec(name: &str, mesh: &obj::LoadedMesh, aspect: f32) -> SceneSpec {
             fov_y_deg: fov,
             near: near as f32,
             far: far as f32,
+            inv_w: false,
         },
     }
 }
@@ -188,7 +193,11 @@ pub fn mvps_with<F: FloatFns>(spec: &SceneSpec, width: u32, height: u32) -> Vec<
     let c = &spec.camera;
     let aspect = width as f32 / height as f32;
     let v = Vec3::from_array;
-    let proj = Mat4::perspective_with::<F>(radians(c.fov_y_deg), aspect, c.near, c.far);
+    let proj = if c.inv_w {
+        Mat4::perspective_inv_w_with::<F>(radians(c.fov_y_deg), aspect, c.near)
+    } else {
+        Mat4::perspective_with::<F>(radians(c.fov_y_deg), aspect, c.near, c.far)
+    };
     let vp = proj * Mat4::look_at_with::<F>(v(c.eye), v(c.target), v(c.up));
     spec.objects
         .iter()
@@ -215,12 +224,12 @@ pub fn mvps64(spec: &SceneSpec, width: u32, height: u32) -> Vec<mat::DMat4> {
     let c = &spec.camera;
     let aspect = width as f64 / height as f64;
     let f = |a: [f32; 3]| a.map(f64::from);
-    let proj = mat::perspective(
-        (c.fov_y_deg as f64).to_radians(),
-        aspect,
-        c.near as f64,
-        c.far as f64,
-    );
+    let fov = (c.fov_y_deg as f64).to_radians();
+    let proj = if c.inv_w {
+        mat::perspective_inv_w(fov, aspect, c.near as f64)
+    } else {
+        mat::perspective(fov, aspect, c.near as f64, c.far as f64)
+    };
     let vp = mat::mul(&proj, &mat::look_at(f(c.eye), f(c.target), f(c.up)));
     spec.objects
         .iter()
