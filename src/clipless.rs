@@ -280,16 +280,7 @@ pub(crate) fn setup<const N: usize>(
     }
     // Window y points down: counter-clockwise in NDC is a negative
     // determinant, as it is a negative area in the clipping mode.
-    let ccw = det < 0;
-    let is_front = match front {
-        FrontFace::Ccw => ccw,
-        FrontFace::Cw => !ccw,
-    };
-    match cull {
-        CullMode::Back if !is_front => return Err(Rejected::Backface),
-        CullMode::Front if is_front => return Err(Rejected::Backface),
-        _ => {}
-    }
+    crate::setup::cull_winding(det < 0, cull, front)?;
     let s = if det < 0 { -1 } else { 1 };
     let d = sample_scale(width, height);
     let bbox = bounding_box(&h, width, height, d)?;

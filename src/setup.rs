@@ -136,6 +136,22 @@ pub(crate) fn inv_w3(w: [f32; 3]) -> [f32; 3] {
     w.map(|w| (m / w as f64) as f32)
 }
 
+/// Face culling: `Err(Backface)` where a triangle that is counter-clockwise
+/// in NDC (`ccw`) or not is culled by `cull` with `front` faces. Shared by
+/// both rasterization modes, which differ only in how they find `ccw`.
+#[inline(always)]
+pub(crate) fn cull_winding(ccw: bool, cull: CullMode, front: FrontFace) -> Result<(), Rejected> {
+    let is_front = match front {
+        FrontFace::Ccw => ccw,
+        FrontFace::Cw => !ccw,
+    };
+    match cull {
+        CullMode::Back if !is_front => Err(Rejected::Backface),
+        CullMode::Front if is_front => Err(Rejected::Backface),
+        _ => Ok(()),
+    }
+}
+
 /// Twice the signed area of a triangle in window space (y down), exactly.
 #[inline]
 pub(crate) fn area2(x: [i32; 3], y: [i32; 3]) -> i64 {
@@ -198,16 +214,7 @@ pub(crate) fn setup_geometry<const S: u32>(
     }
     // Window y points down, so a counter-clockwise triangle in NDC has a
     // negative window-space area.
-    let ccw = area < 0;
-    let is_front = match front {
-        FrontFace::Ccw => ccw,
-        FrontFace::Cw => !ccw,
-    };
-    match cull {
-        CullMode::Back if !is_front => return Err(Rejected::Backface),
-        CullMode::Front if is_front => return Err(Rejected::Backface),
-        _ => {}
-    }
+    cull_winding(area < 0, cull, front)?;
     let swapped = area < 0;
     let (x, y, z, area) = if swapped {
         (
