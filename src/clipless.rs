@@ -67,7 +67,7 @@
 use crate::clip::ClipVertex;
 use crate::color::PixelFormat;
 use crate::config::{CullMode, FrontFace};
-use crate::depth::{z32_of, DepthBuffer};
+use crate::depth::DepthBuffer;
 use crate::math::Vec4;
 use crate::raster::Strip;
 use crate::setup::Rejected;
@@ -510,7 +510,7 @@ pub(crate) fn draw<
             if D::ENABLED
                 && !strip.depth.test_and_set(
                     idx,
-                    z32_of(zn, D::FRAC),
+                    D::key_of(zn),
                     strip.depth_func,
                     strip.depth_write,
                 )

@@ -1,4 +1,4 @@
-//! Depth buffers: `u16`, `u32` or none at all.
+//! Depth buffers: `u16`, `u32`, `f32` ([`DepthF32`]) or none at all.
 //!
 //! Design note: the rasterizer is generic over [`DepthBuffer`], so a scene
 //! drawn with [`NoDepth`] compiles to a loop with no depth arithmetic in it
@@ -6,6 +6,16 @@
 //! in `[0, 1]`: `Z32` (`u32`, `z * 2^32` saturated) or `Z16` (`u16`, the top
 //! 16 bits of `Z32`). Clear a buffer to `u16::MAX` / `u32::MAX` (the far
 //! plane) before drawing with [`DepthFunc::Less`].
+//!
+//! [`DepthF32`] stores an IEEE `f32` in `[0, 1)`, made from the stepped
+//! `Z32.16` value (48 fraction bits) with integer operations only (no
+//! float rounding mode or FPU is involved, so it is the same on every
+//! core): the value truncated to 24 significant bits. Non-negative floats
+//! order as their bit patterns, so the buffer compares those bits as a
+//! `u32` ([`DepthWord::key`]). Its precision is relative, `2^-24` of the
+//! value down to `2^-24`, where a `u32` buffer keeps `2^-32` absolute: less
+//! near 1, far more near 0, which is where a reversed 1/w depth
+//! (`Mat4::perspective_inv_w`) puts distant surfaces.
 
 /// The depth comparison: a fragment passes when `func(new, stored)` holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -72,8 +82,25 @@ pub trait DepthBuffer {
     /// The number of depth values held, or `None` without a buffer.
     fn depth_len(&self) -> Option<usize>;
 
-    /// Tests `z` (`Z32`) against the value at `index` and, if it passes and
-    /// `write` is set, stores it. An index out of range fails the test.
+    /// The key [`test_and_set`](DepthBuffer::test_and_set) takes for the
+    /// `Z32.F` depth `z` (`F` = [`DepthBuffer::FRAC`], clamped to `[0, 1]`):
+    /// its `Z32` by default and for `u16` and `u32` buffers, the `f32`'s
+    /// bits for [`DepthF32`] buffers (which keep more than `Z32` near 0).
+    #[inline(always)]
+    fn key_of(z: i64) -> u32 {
+        z32_of(z, Self::FRAC)
+    }
+
+    /// Whether [`key_of`](DepthBuffer::key_of) keeps more than `Z32`
+    /// ([`DepthF32`] buffers): then every pixel's key is made from its
+    /// `Z32.F` depth, where otherwise small triangles take their `Z32`
+    /// straight from the interpolated float.
+    const FINE_KEY: bool = false;
+
+    /// Tests `z` against the value at `index` and, if it passes and `write`
+    /// is set, stores it. `z` is the buffer's key for the depth
+    /// ([`DepthBuffer::key_of`]): `Z32` for `u16` and `u32` buffers. An
+    /// index out of range fails the test.
     fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool;
 
     /// Draws a span of one flat colour: pixels `start..start + len`, where
@@ -145,7 +172,7 @@ fn flat_span_each<B: DepthBuffer + ?Sized, C: Copy>(
     let mut written = 0;
     let mut z = z0;
     for (n, cp) in c.iter_mut().enumerate() {
-        if buf.test_and_set(start + n, z32_of(z, B::FRAC), func, write) {
+        if buf.test_and_set(start + n, B::key_of(z), func, write) {
             *cp = px;
             written += 1;
         }
@@ -296,6 +323,22 @@ pub trait DepthWord: Copy + Ord + Default + core::fmt::Debug + Send + Sync + 'st
     fn key_in_range(z: u64) -> u32 {
         Self::from_fixed_in_range(z).key()
     }
+    /// The key [`DepthBuffer::key_of`] gives buffers of this word for a
+    /// `Z32.F` depth: `Z32` by default (what
+    /// [`DepthWord::from_key`] reads back).
+    #[inline(always)]
+    fn key_of_fixed(z: i64) -> u32 {
+        z32_of(z, Self::FRAC)
+    }
+    /// Whether [`DepthWord::key_of_fixed`] keeps more than `Z32`
+    /// ([`DepthBuffer::FINE_KEY`]).
+    const FINE: bool = false;
+    /// The word for a key of [`DepthWord::key_of_fixed`]: `from_z32` by
+    /// default.
+    #[inline(always)]
+    fn from_key(key: u32) -> Self {
+        Self::from_z32(key)
+    }
 }
 
 impl DepthWord for u16 {
@@ -347,6 +390,113 @@ impl DepthWord for u32 {
     #[inline(always)]
     fn to_z32(self) -> u32 {
         self
+    }
+}
+
+/// An `f32` depth word in `[0, 1)`, kept as its IEEE bits (see the module
+/// note): `Z32.16` truncated to 24 significant bits, made and compared
+/// with integer operations only. [`DepthF32::get`] (or `f32::from`) reads
+/// the float; [`DepthF32::new`] makes one from a float (clamped to
+/// `[0, 1)`, NaN as 0), e.g. to clear to a depth of your own.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[repr(transparent)]
+pub struct DepthF32(u32);
+
+impl DepthF32 {
+    /// The largest value, the largest `f32` below 1: [`DepthWord::FAR`].
+    const MAX_BITS: u32 = 0x3f7f_ffff;
+
+    /// The word for `z`, clamped to `[0, 1)` (1 and above give the
+    /// largest `f32` below 1, the far plane; NaN gives 0).
+    pub fn new(z: f32) -> Self {
+        if z > 0.0 {
+            DepthF32(z.to_bits().min(Self::MAX_BITS))
+        } else {
+            DepthF32(0)
+        }
+    }
+
+    /// The depth as a float.
+    pub fn get(self) -> f32 {
+        f32::from_bits(self.0)
+    }
+
+    /// The IEEE bits (which order as the values do).
+    pub fn to_bits(self) -> u32 {
+        self.0
+    }
+
+    /// The word for a `Z32.16` value `z < 2^48` (`z / 2^48`), truncated to
+    /// 24 significant bits: the leading one found with a count of leading
+    /// zeros, the next 23 bits the mantissa, the exponent from its place.
+    #[inline(always)]
+    fn of_fixed(z: u64) -> Self {
+        if z == 0 {
+            return DepthF32(0);
+        }
+        let lz = z.leading_zeros(); // 16..=63 for 0 < z < 2^48
+        let mantissa = ((z << lz) >> 40) as u32 & 0x7f_ffff;
+        // z = 1.m * 2^(63 - lz), so z / 2^48 = 1.m * 2^(15 - lz): biased
+        // exponent 127 + 15 - lz, in 79..=126.
+        DepthF32((142 - lz) << 23 | mantissa)
+    }
+}
+
+impl From<DepthF32> for f32 {
+    fn from(d: DepthF32) -> f32 {
+        d.get()
+    }
+}
+
+/// `f32` depth: 16 fraction bits below `Z32` in the spans (as `u32`), all
+/// of them kept where the value is small.
+impl DepthWord for DepthF32 {
+    const FAR: Self = DepthF32(DepthF32::MAX_BITS);
+    const NEAR: Self = DepthF32(0);
+    const WIDE: bool = true;
+    /// `Z32 / 2^32`, truncated to 24 significant bits.
+    #[inline(always)]
+    fn from_z32(z: u32) -> Self {
+        Self::of_fixed((z as u64) << 16)
+    }
+    /// `value * 2^32`, truncated (exact for every word made from a `Z32`).
+    fn to_z32(self) -> u32 {
+        if self.0 == 0 {
+            return 0;
+        }
+        let exp = (self.0 >> 23) as i32; // 79..=126 for words made here
+        let m = (self.0 & 0x7f_ffff | 0x80_0000) as u64;
+        // value = m * 2^(exp - 150), so value * 2^32 = m * 2^(exp - 118).
+        let s = exp - 118;
+        let z = if s >= 0 {
+            m.checked_shl(s as u32).unwrap_or(u64::MAX)
+        } else {
+            m.checked_shr((-s) as u32).unwrap_or(0)
+        };
+        z.min(u32::MAX as u64) as u32
+    }
+    #[inline(always)]
+    fn from_fixed(z: i64) -> Self {
+        Self::of_fixed(z.clamp(0, (1i64 << 48) - 1) as u64)
+    }
+    #[inline(always)]
+    fn from_fixed_in_range(z: u64) -> Self {
+        Self::of_fixed(z)
+    }
+    /// The bits.
+    #[inline(always)]
+    fn key(self) -> u32 {
+        self.0
+    }
+    /// The bits of [`DepthWord::from_fixed`]: more than `Z32` near 0.
+    #[inline(always)]
+    fn key_of_fixed(z: i64) -> u32 {
+        Self::from_fixed(z).0
+    }
+    const FINE: bool = true;
+    #[inline(always)]
+    fn from_key(key: u32) -> Self {
+        DepthF32(key)
     }
 }
 
@@ -459,9 +609,16 @@ impl<W: DepthWord> DepthBuffer for [W] {
         Some(self.len())
     }
 
+    #[inline(always)]
+    fn key_of(z: i64) -> u32 {
+        W::key_of_fixed(z)
+    }
+
+    const FINE_KEY: bool = W::FINE;
+
     #[inline]
     fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
-        let z = W::from_z32(z);
+        let z = W::from_key(z);
         match self.get_mut(index) {
             Some(d) if func.test(z, *d) => {
                 if write {
@@ -513,6 +670,13 @@ impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
     fn depth_len(&self) -> Option<usize> {
         Some(N)
     }
+
+    #[inline(always)]
+    fn key_of(z: i64) -> u32 {
+        W::key_of_fixed(z)
+    }
+
+    const FINE_KEY: bool = W::FINE;
 
     #[inline]
     fn test_and_set(&mut self, index: usize, z: u32, func: DepthFunc, write: bool) -> bool {
@@ -623,6 +787,41 @@ mod tests {
 
         /// The same for `u16` buffers, whose spans step `Z32.0`: starts
         /// around `[0, 2^32)` and its ends.
+        /// The same for `f32` buffers (`Z32.16`, keyed by the bits).
+        #[test]
+        fn unclamped_span_equals_clamped_f32(
+            z0 in prop_oneof![0i64..1 << 48, -(1i64 << 20)..1 << 20, (1i64 << 48) - (1 << 20)..(1i64 << 48) + (1 << 20), any::<i64>()],
+            dz in prop_oneof![-(1i64 << 34)..1 << 34, -(1i64 << 42)..1 << 42, -4i64..4, any::<i64>()],
+            len in 1usize..300,
+            seed in any::<u64>(),
+            le in any::<bool>(),
+        ) {
+            unclamped_matches::<DepthF32>(z0, dz, len, seed, le);
+        }
+
+        /// `DepthF32` is `z / 2^48` truncated to an `f32` (against the
+        /// exact `f64` quotient, `z < 2^53`), orders as its bits, and
+        /// reads back through `Z32`.
+        #[test]
+        fn f32_word_is_the_truncated_quotient(z in prop_oneof![0u64..1 << 48, 0u64..1 << 24, 0u64..1 << 8], y in 0u64..1 << 48) {
+            let exact = z as f64 / (1u64 << 48) as f64;
+            let mut want = exact as f32;
+            if want as f64 > exact {
+                want = f32::from_bits(want.to_bits() - 1);
+            }
+            let d = DepthF32::of_fixed(z);
+            prop_assert_eq!(d.get().to_bits(), want.to_bits());
+            prop_assert_eq!(DepthF32::from_fixed(z as i64), d);
+            prop_assert_eq!(d.key(), d.get().to_bits());
+            prop_assert_eq!(d <= DepthF32::of_fixed(y), z <= y || d == DepthF32::of_fixed(y));
+            prop_assert!(d <= DepthF32::FAR);
+            let z32 = (z >> 16) as u32;
+            let w = DepthF32::from_z32(z32);
+            prop_assert!(w.to_z32() <= z32);
+            prop_assert_eq!(DepthF32::from_z32(w.to_z32()), w);
+            prop_assert_eq!(<[DepthF32] as DepthBuffer>::key_of(z as i64), d.key());
+        }
+
         #[test]
         fn unclamped_span_equals_clamped_z32(
             z0 in prop_oneof![0i64..1 << 32, -(1i64 << 12)..1 << 12, (1i64 << 32) - (1 << 12)..(1i64 << 32) + (1 << 12), any::<i64>()],
@@ -654,6 +853,32 @@ mod tests {
         }
         check::<u16>();
         check::<u32>();
+        check::<DepthF32>();
+    }
+
+    #[test]
+    fn f32_word_ends_and_clamps() {
+        assert_eq!(DepthF32::from_fixed(-5), DepthF32::NEAR);
+        assert_eq!(DepthF32::NEAR.get(), 0.0);
+        assert_eq!(DepthF32::from_fixed(1 << 48), DepthF32::FAR);
+        assert_eq!(DepthF32::from_fixed(i64::MAX), DepthF32::FAR);
+        assert_eq!(DepthF32::from_z32(u32::MAX), DepthF32::FAR);
+        assert_eq!(DepthF32::FAR.get(), 1.0 - f32::EPSILON / 2.0);
+        assert_eq!(DepthF32::from_z32(1 << 31).get(), 0.5);
+        assert_eq!(DepthF32::from_z32(1).get(), 1.0 / 4_294_967_296.0);
+        assert_eq!(DepthF32::from_fixed(1).get(), 1.0 / 281_474_976_710_656.0);
+        assert_eq!(DepthF32::new(0.25).get(), 0.25);
+        assert_eq!(DepthF32::new(2.0), DepthF32::FAR);
+        assert_eq!(DepthF32::new(f32::NAN), DepthF32::NEAR);
+        assert_eq!(DepthF32::new(-1.0), DepthF32::NEAR);
+        assert_eq!(f32::from(DepthF32::new(0.75)), 0.75);
+        // Keyed by bits: a test through the slice compares floats.
+        let mut d = [DepthF32::FAR; 2];
+        let k = <[DepthF32] as DepthBuffer>::key_of(3 << 44);
+        assert!(d[..].test_and_set(0, k, DepthFunc::Less, true));
+        assert_eq!(d[0].get(), 3.0 / 16.0);
+        assert!(!d[..].test_and_set(0, k, DepthFunc::Less, true));
+        assert!(d[..].test_and_set(0, k, DepthFunc::LessEqual, true));
     }
 
     #[test]

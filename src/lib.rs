@@ -70,7 +70,7 @@
 //! | storage | `frame.rs`, `bins.rs` | [`Frame`]: set-up triangles in caller storage, per-strip [`Bins`] |
 //! | immediate mode | `strip_renderer.rs` | [`StripRenderer`]: setup straight into one strip |
 //! | traversal | `raster.rs` | exact edge functions, top-left rule, spans, depth and colour steps |
-//! | depth | `depth.rs` | [`DepthBuffer`], [`DepthWord`] (`u16`, `u32`), [`NoDepth`], [`DepthFunc`] |
+//! | depth | `depth.rs` | [`DepthBuffer`], [`DepthWord`] (`u16`, `u32`, [`DepthF32`]), [`NoDepth`], [`DepthFunc`] |
 //! | pixels | `color.rs` | [`PixelFormat`]: embedded-graphics colours, [`TriangleId`] |
 //! | display | `draw_target.rs` | [`StripDrawer`]: strips into a `DrawTarget` |
 
@@ -104,7 +104,7 @@ pub use clip::ClipVertex;
 pub use color::{PixelFormat, TriangleId};
 pub use config::{Config, CullMode, Error, FrontFace, RasterMode};
 pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Detail};
-pub use depth::{DepthBuffer, DepthFunc, DepthWord, NoDepth};
+pub use depth::{DepthBuffer, DepthF32, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
 pub use frame::Frame;

@@ -63,7 +63,7 @@
 //! equal varyings is shaded once per strip.
 
 use crate::color::PixelFormat;
-use crate::depth::{z32_of, DepthBuffer, DepthFunc};
+use crate::depth::{DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use crate::shade::FragmentShader;
 
@@ -507,6 +507,18 @@ fn f64_as_i64(x: f64) -> i64 {
     x as i64
 }
 
+/// The depth key of a small triangle's pixel at interpolated depth `z`
+/// (`Z32` units): `Z32` itself, floored, or, for buffers that keep more
+/// ([`DepthBuffer::FINE_KEY`]), the key of its `Z32.F` value.
+#[inline(always)]
+fn small_key<D: DepthBuffer + ?Sized, R: Real>(z: R) -> u32 {
+    if D::FINE_KEY {
+        D::key_of(z.to_fixed(D::FRAC))
+    } else {
+        z.to_u32()
+    }
+}
+
 /// Per-triangle constants for shading a covered pixel.
 struct Shader<R, const N: usize> {
     /// `Z0`.
@@ -794,8 +806,15 @@ fn draw_in<
                     {
                         shader.resync(t, e, &mut acc);
                     }
-                    written +=
-                        shader.pixel(t, strip, fragment, base + k, &acc, acc.z.to_u32(), flat);
+                    written += shader.pixel(
+                        t,
+                        strip,
+                        fragment,
+                        base + k,
+                        &acc,
+                        small_key::<D, R>(acc.z),
+                        flat,
+                    );
                     e[0] += step[0];
                     e[1] += step[1];
                     e[2] += step[2];
@@ -825,8 +844,7 @@ fn draw_in<
                     if (n - lo).is_multiple_of(resync(N)) && n != lo {
                         shader.resync(t, e, &mut acc);
                     }
-                    written +=
-                        shader.pixel(t, strip, fragment, base + n, &acc, z32_of(z, D::FRAC), flat);
+                    written += shader.pixel(t, strip, fragment, base + n, &acc, D::key_of(z), flat);
                     z = z.wrapping_add(shader.dz_fixed);
                     e[0] += edges[0].step_x;
                     e[1] += edges[1].step_x;
@@ -928,7 +946,7 @@ fn window_rows<
                             fragment,
                             at(row, k),
                             &acc,
-                            acc.z.to_u32(),
+                            small_key::<D, R>(acc.z),
                             flat,
                         );
                     }
@@ -977,15 +995,8 @@ fn window_rows<
                         if (n - lo_n).is_multiple_of(r) && n != lo_n && n != p {
                             shader.resync(t, e, &mut acc);
                         }
-                        written += shader.pixel(
-                            t,
-                            strip,
-                            fragment,
-                            at(row, n),
-                            &acc,
-                            z32_of(z, D::FRAC),
-                            flat,
-                        );
+                        written +=
+                            shader.pixel(t, strip, fragment, at(row, n), &acc, D::key_of(z), flat);
                         z = z.wrapping_add(shader.dz_fixed);
                         e[0] += edges[0].step_x;
                         e[1] += edges[1].step_x;

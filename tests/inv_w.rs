@@ -8,7 +8,8 @@ mod common;
 use microraster::pixelcolor::Rgb888;
 use microraster::prelude::*;
 use microraster::{
-    Config, CullMode, DepthFunc, Mat4, NoDepth, RasterMode, StripRenderer, TriangleId, Vec3, Vec4,
+    Config, CullMode, DepthF32, DepthFunc, DepthWord, Mat4, NoDepth, RasterMode, StripRenderer,
+    TriangleId, Vec3, Vec4,
 };
 
 const W: u32 = 64;
@@ -36,6 +37,16 @@ fn projections() -> (Mat4, Mat4) {
 /// Draws eye-space triangles with `proj` into a `u32` depth buffer (ids
 /// too): window z under `Less` from 1.0, 1/w under `Greater` from 0.
 fn draw(mode: RasterMode, proj: &Mat4, inv_w: bool, tris: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
+    draw_with::<u32>(mode, proj, inv_w, tris)
+}
+
+/// [`draw`] into a buffer of `W` words.
+fn draw_with<Z: DepthWord>(
+    mode: RasterMode,
+    proj: &Mat4,
+    inv_w: bool,
+    tris: &[[Vec3; 3]],
+) -> (Vec<u32>, Vec<Z>) {
     let mut config = Config::new(W, H);
     config.cull = CullMode::None;
     config.mode = mode;
@@ -46,7 +57,7 @@ fn draw(mode: RasterMode, proj: &Mat4, inv_w: bool, tris: &[[Vec3; 3]]) -> (Vec<
     };
     let n = (W * H) as usize;
     let mut ids = vec![TriangleId(0); n];
-    let mut depth = vec![if inv_w { 0u32 } else { u32::MAX }; n];
+    let mut depth = vec![if inv_w { Z::NEAR } else { Z::FAR }; n];
     let mut r = StripRenderer::new(config, 0, H, &mut ids, &mut depth[..]).unwrap();
     for (i, t) in tris.iter().enumerate() {
         let c = t.map(|p| proj.transform_point(p));
@@ -217,4 +228,48 @@ fn same_visibility_as_window_z() {
     }
     let _ = NoDepth;
     let _ = Vec4::new(0.0, 0.0, 0.0, 1.0);
+}
+
+/// An `f32` buffer holds the `u32` buffer's depths to its own precision
+/// (24 significant bits, truncated: within `2^-23` of the value, and never
+/// more than one `Z32` unit below where the `u32` keeps fewer bits), with
+/// the same pixels, in both modes and both depth kinds; far away (1/w
+/// near 0) it keeps bits below `Z32`. (Those bits are interpolation, not
+/// accuracy: vertex depths are `Z32`, made from an `f32` window depth, so
+/// the `f32` buffer is no closer to the exact 1/w than the `u32` one.)
+#[test]
+fn f32_buffer_holds_the_u32_depths() {
+    let (z, inv) = projections();
+    for mode in modes() {
+        for (proj, inv_w) in [(&z, false), (&inv, true)] {
+            let tris = random_tris(5, 60);
+            let (ia, a) = draw_with::<u32>(mode, proj, inv_w, &tris);
+            let (ib, b) = draw_with::<DepthF32>(mode, proj, inv_w, &tris);
+            let mut finer = 0;
+            for i in 0..a.len() {
+                if ia[i] != ib[i] {
+                    // Only where two surfaces tie to within the rounding.
+                    let d = (a[i] as f64 - b[i].get() as f64 * 4_294_967_296.0).abs();
+                    assert!(
+                        d < 1e-5 * a[i] as f64,
+                        "{mode:?} {inv_w} pixel {i}: ids {} {} depths {} {:?}",
+                        ia[i],
+                        ib[i],
+                        a[i],
+                        b[i]
+                    );
+                    continue;
+                }
+                let (u, f) = (a[i] as f64, b[i].get() as f64 * 4_294_967_296.0);
+                assert!(
+                    (u - f).abs() <= (u / 8_388_608.0).max(1.0),
+                    "{mode:?} inv_w {inv_w} pixel {i}: u32 {u}, f32 {f}"
+                );
+                finer += (f.fract() != 0.0) as u32;
+            }
+            if inv_w {
+                assert!(finer > 10, "{mode:?}: {finer} depths below one Z32 unit");
+            }
+        }
+    }
 }

@@ -153,6 +153,9 @@ pub enum DepthArg {
     U16,
     /// 32-bit depth buffer.
     U32,
+    /// `f32` depth buffer (`DepthF32`: 24 significant bits, finer than
+    /// `u32` near 0, where 1/w depth puts distant surfaces).
+    F32,
     /// No depth buffer (painter's order).
     None,
 }
@@ -959,7 +962,7 @@ mod tests {
             &["--threads", "many"],
             &["--strip-rows", "0"],
             &["--cull", "sideways"],
-            &["--depth", "f32"],
+            &["--depth", "f64"],
             &["--subpixel", "6"],
             &["--fov", "0"],
             &["--fov", "180"],

@@ -19,8 +19,8 @@ use crate::scene::Scene;
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::prelude::{DepthWord, Submit};
 use microraster::{
-    Config, CullMode, DepthFunc, NoDepth, PixelFormat, ProcessedVertex, RasterMode, Stats,
-    StripRenderer, TriangleId,
+    Config, CullMode, DepthF32, DepthFunc, NoDepth, PixelFormat, ProcessedVertex, RasterMode,
+    Stats, StripRenderer, TriangleId,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -35,6 +35,8 @@ pub enum DepthKind {
     U16,
     /// 32-bit depth.
     U32,
+    /// `f32` depth ([`microraster::DepthF32`]).
+    F32,
     /// No depth buffer: later triangles draw over earlier ones.
     None,
 }
@@ -77,6 +79,8 @@ pub enum DepthImage {
     U16(Vec<u16>),
     /// 32-bit values, row 0 first.
     U32(Vec<u32>),
+    /// `f32` values, row 0 first.
+    F32(Vec<microraster::DepthF32>),
     /// No depth buffer.
     None,
 }
@@ -87,6 +91,7 @@ impl DepthImage {
         match self {
             DepthImage::U16(v) => v.iter().flat_map(|d| d.to_le_bytes()).collect(),
             DepthImage::U32(v) => v.iter().flat_map(|d| d.to_le_bytes()).collect(),
+            DepthImage::F32(v) => v.iter().flat_map(|d| d.get().to_le_bytes()).collect(),
             DepthImage::None => Vec::new(),
         }
     }
@@ -339,6 +344,17 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
                         let mut d = vec![if reversed { 0 } else { u32::MAX }; len];
                         strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::U32(d), px))
                     }
+                    DepthKind::F32 => {
+                        let mut d = vec![
+                            if reversed {
+                                DepthF32::NEAR
+                            } else {
+                                DepthF32::FAR
+                            };
+                            len
+                        ];
+                        strips!($c, $clear, Some(&mut d[..])).map(|px| (DepthImage::F32(d), px))
+                    }
                     DepthKind::None => {
                         strips!($c, $clear, None::<&mut [u32]>).map(|px| (DepthImage::None, px))
                     }
@@ -405,6 +421,16 @@ fn draw_image<const S: u32, C: PixelFormat + Send + Sync>(
             let mut d = vec![z; len];
             let px = draw_layers_cleared(layers, color, Some(&mut d[..]), threads, Some(clear), z);
             (DepthImage::U32(d), px)
+        }
+        DepthKind::F32 => {
+            let z = if opts.inv_w {
+                DepthF32::NEAR
+            } else {
+                DepthF32::FAR
+            };
+            let mut d = vec![z; len];
+            let px = draw_layers_cleared(layers, color, Some(&mut d[..]), threads, Some(clear), z);
+            (DepthImage::F32(d), px)
         }
         DepthKind::None => {
             let px = draw_layers::<S, C, u32>(layers, color, None, threads, Some(clear));

@@ -375,6 +375,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         depth: match args.depth {
             DepthArg::U16 => DepthKind::U16,
             DepthArg::U32 => DepthKind::U32,
+            DepthArg::F32 => DepthKind::F32,
             DepthArg::None => DepthKind::None,
         },
         subpixel: args.subpixel,

@@ -438,6 +438,19 @@ where
             )?;
             (DepthImage::U32(d), px)
         }
+        DepthKind::F32 => {
+            let mut d = vec![microraster::DepthF32::FAR; len];
+            let px = draw_with(
+                frame,
+                color,
+                Some(&mut d[..]),
+                clear,
+                (tile_w, rows),
+                threads,
+                fragment,
+            )?;
+            (DepthImage::F32(d), px)
+        }
         DepthKind::None => {
             let px = draw_with::<S, N, C, F, u32>(
                 frame,

@@ -250,17 +250,29 @@ pub fn bench(bs: &mut BenchScene, s: &Settings) -> Result<Report, String> {
         (4, ColorArg::Rgb888, DepthArg::U16) => {
             bench_with::<4, Rgb888, u16>(bs, s, depth_on, &mut p)
         }
+        (4, ColorArg::Rgb888, DepthArg::F32) => {
+            bench_with::<4, Rgb888, microraster::DepthF32>(bs, s, depth_on, &mut p)
+        }
         (4, ColorArg::Rgb888, _) => bench_with::<4, Rgb888, u32>(bs, s, depth_on, &mut p),
         (4, ColorArg::Rgb565, DepthArg::U16) => {
             bench_with::<4, Rgb565, u16>(bs, s, depth_on, &mut p)
+        }
+        (4, ColorArg::Rgb565, DepthArg::F32) => {
+            bench_with::<4, Rgb565, microraster::DepthF32>(bs, s, depth_on, &mut p)
         }
         (4, ColorArg::Rgb565, _) => bench_with::<4, Rgb565, u32>(bs, s, depth_on, &mut p),
         (8, ColorArg::Rgb888, DepthArg::U16) => {
             bench_with::<8, Rgb888, u16>(bs, s, depth_on, &mut p)
         }
+        (8, ColorArg::Rgb888, DepthArg::F32) => {
+            bench_with::<8, Rgb888, microraster::DepthF32>(bs, s, depth_on, &mut p)
+        }
         (8, ColorArg::Rgb888, _) => bench_with::<8, Rgb888, u32>(bs, s, depth_on, &mut p),
         (8, ColorArg::Rgb565, DepthArg::U16) => {
             bench_with::<8, Rgb565, u16>(bs, s, depth_on, &mut p)
+        }
+        (8, ColorArg::Rgb565, DepthArg::F32) => {
+            bench_with::<8, Rgb565, microraster::DepthF32>(bs, s, depth_on, &mut p)
         }
         (8, ColorArg::Rgb565, _) => bench_with::<8, Rgb565, u32>(bs, s, depth_on, &mut p),
         (other, ..) => return Err(format!("unsupported subpixel precision {other}")),
@@ -403,6 +415,7 @@ fn depth_name(d: DepthArg) -> &'static str {
     match d {
         DepthArg::U16 => "u16",
         DepthArg::U32 => "u32",
+        DepthArg::F32 => "f32",
         DepthArg::None => "none",
     }
 }

@@ -351,6 +351,7 @@ fn render_fn_section(
         depth: match s.depth {
             DepthArg::U16 => DepthKind::U16,
             DepthArg::U32 => DepthKind::U32,
+            DepthArg::F32 => DepthKind::F32,
             DepthArg::None => DepthKind::None,
         },
         subpixel: s.subpixel,

@@ -50,8 +50,36 @@ pub(crate) struct CoreRun {
     pub(crate) ids: Vec<u32>,
     /// Colour per pixel.
     pub(crate) color: Vec<Rgb888>,
-    /// Depth per pixel.
+    /// Depth per pixel, in units of `2^-bits` ([`Configuration::compare_bits`]):
+    /// the word itself for `u16` and `u32`, `Z32.16` for `f32` (exact).
     pub(crate) depth: Vec<u64>,
+}
+
+/// A depth word the report reads back as an integer of its comparison
+/// units ([`Configuration::compare_bits`]).
+pub(crate) trait ReportDepth: DepthWord {
+    /// The stored depth in units of `2^-bits`.
+    fn units(self) -> u64;
+}
+
+impl ReportDepth for u16 {
+    fn units(self) -> u64 {
+        self as u64
+    }
+}
+
+impl ReportDepth for u32 {
+    fn units(self) -> u64 {
+        self as u64
+    }
+}
+
+/// `value * 2^48`: exact, every `f32` the buffer holds is a multiple of
+/// `2^-48`.
+impl ReportDepth for microraster::DepthF32 {
+    fn units(self) -> u64 {
+        (self.get() as f64 * (1u64 << 48) as f64) as u64
+    }
 }
 
 pub(crate) struct CoreInput<'a> {
@@ -74,7 +102,7 @@ pub(crate) fn frame_once<const S: u32, C, T>(
 ) -> Result<(), Error>
 where
     C: microraster::PixelFormat,
-    T: DepthWord + Into<u64>,
+    T: ReportDepth,
     [T]: DepthBuffer,
 {
     let (w, h) = (input.width, input.height);
@@ -138,7 +166,7 @@ fn immediate_frame<const S: u32, C, T>(
 ) -> Result<(), Error>
 where
     C: microraster::PixelFormat,
-    T: DepthWord + Into<u64>,
+    T: ReportDepth,
     [T]: DepthBuffer,
 {
     let w = input.width as usize;
@@ -196,7 +224,7 @@ pub(crate) struct TypedRunner<'a, const S: u32, T> {
 
 impl<'a, const S: u32, T> TypedRunner<'a, S, T>
 where
-    T: DepthWord + Into<u64>,
+    T: ReportDepth,
     [T]: DepthBuffer,
 {
     /// Allocates everything and renders one frame to warm up (growing the
@@ -234,7 +262,7 @@ where
 
 impl<const S: u32, T> Runner for TypedRunner<'_, S, T>
 where
-    T: DepthWord + Into<u64>,
+    T: ReportDepth,
     [T]: DepthBuffer,
 {
     fn frame(&mut self) -> Result<f64, String> {
@@ -268,7 +296,7 @@ where
         Ok(CoreRun {
             ids: ids.into_iter().map(|t| t.0).collect(),
             color: self.color.clone(),
-            depth: self.depth.iter().map(|&d| d.into()).collect(),
+            depth: self.depth.iter().map(|&d| d.units()).collect(),
         })
     }
 }
@@ -279,11 +307,16 @@ pub(crate) fn runner<'a>(
     c: Configuration,
 ) -> Result<Box<dyn Runner + 'a>, String> {
     let v = c.variant;
-    Ok(match (c.subpixel, c.depth_bits) {
-        (4, 16) => Box::new(TypedRunner::<4, u16>::new(input, v)?),
-        (4, 32) => Box::new(TypedRunner::<4, u32>::new(input, v)?),
-        (8, 16) => Box::new(TypedRunner::<8, u16>::new(input, v)?),
-        (8, 32) => Box::new(TypedRunner::<8, u32>::new(input, v)?),
-        (s, d) => return Err(format!("unsupported configuration S={s} depth u{d}")),
+    Ok(match (c.subpixel, c.depth_bits, c.float_depth) {
+        (4, 16, false) => Box::new(TypedRunner::<4, u16>::new(input, v)?),
+        (4, 32, false) => Box::new(TypedRunner::<4, u32>::new(input, v)?),
+        (8, 16, false) => Box::new(TypedRunner::<8, u16>::new(input, v)?),
+        (8, 32, false) => Box::new(TypedRunner::<8, u32>::new(input, v)?),
+        (8, 32, true) => Box::new(TypedRunner::<8, microraster::DepthF32>::new(input, v)?),
+        (s, d, f) => {
+            return Err(format!(
+                "unsupported configuration S={s} depth {d} bits (float {f})"
+            ))
+        }
     })
 }

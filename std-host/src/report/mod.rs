@@ -155,6 +155,8 @@ pub struct Configuration {
     pub subpixel: u32,
     /// Depth buffer bits: 16 or 32.
     pub depth_bits: u32,
+    /// A float depth buffer (`f32`, [`microraster::DepthF32`]; 32 bits).
+    pub float_depth: bool,
     /// Float backend of the matrices.
     pub math: MathBackend,
     /// Mode, depth kind, tiles.
@@ -165,8 +167,9 @@ impl Configuration {
     /// A short name, e.g. `S8 u16 libm`, `S8 u16 libm clipless`, `S8 u16
     /// libm tiles 32x32`.
     pub fn label(&self) -> String {
+        let word = if self.float_depth { "f" } else { "u" };
         let base = format!(
-            "S{} u{} {}",
+            "S{} {word}{} {}",
             self.subpixel,
             self.depth_bits,
             self.math.name()
@@ -179,12 +182,24 @@ impl Configuration {
             Variant::Tiles(n) => format!("{base} tiles {n}x{n}"),
         }
     }
+
+    /// The bits of the depth units the report compares in: the word's
+    /// for `u16` and `u32`, 48 (`Z32.16`, where an `f32` buffer's values
+    /// are whole) for `f32`.
+    pub fn compare_bits(&self) -> u32 {
+        if self.float_depth {
+            48
+        } else {
+            self.depth_bits
+        }
+    }
 }
 
 const fn config(subpixel: u32, depth_bits: u32, variant: Variant) -> Configuration {
     Configuration {
         subpixel,
         depth_bits,
+        float_depth: false,
         math: MathBackend::Libm,
         variant,
     }
@@ -192,13 +207,14 @@ const fn config(subpixel: u32, depth_bits: u32, variant: Variant) -> Configurati
 
 /// Every configuration the report compares: the grid of eight, then the
 /// variants on `S8 libm`.
-pub const CONFIGURATIONS: [Configuration; 16] = {
-    let mut out = [config(8, 16, Variant::Base); 16];
+pub const CONFIGURATIONS: [Configuration; 17] = {
+    let mut out = [config(8, 16, Variant::Base); 17];
     let mut i = 0;
     while i < 8 {
         out[i] = Configuration {
             subpixel: if i & 4 == 0 { 4 } else { 8 },
             depth_bits: if i & 2 == 0 { 16 } else { 32 },
+            float_depth: false,
             math: if i & 1 == 0 {
                 MathBackend::Libm
             } else {
@@ -216,6 +232,10 @@ pub const CONFIGURATIONS: [Configuration; 16] = {
     out[13] = config(8, 16, Variant::Tiles(16));
     out[14] = config(8, 16, Variant::Tiles(32));
     out[15] = config(8, 16, Variant::Tiles(64));
+    out[16] = Configuration {
+        float_depth: true,
+        ..config(8, 32, Variant::InvW)
+    };
     out
 };
 
@@ -454,7 +474,7 @@ impl SceneRefs {
             Variant::Clipless => Tolerance::clipless(width, height, &vertex),
             _ => Tolerance::new(c.subpixel, &vertex),
         };
-        let errors = compare(run, c.depth_bits, reference, prepared, tolerance);
+        let errors = compare(run, c.compare_bits(), reference, prepared, tolerance);
         (errors, vertex)
     }
 }
@@ -666,7 +686,12 @@ mod tests {
                 config.variant,
                 Variant::Base | Variant::Tiles(_) | Variant::Immediate
             ) {
-                let key = (config.subpixel, config.depth_bits, config.math);
+                let key = (
+                    config.subpixel,
+                    config.depth_bits,
+                    config.float_depth,
+                    config.math,
+                );
                 let frame = (run.ids.clone(), run.color.clone(), run.depth.clone());
                 assert!(
                     *frames.entry(key).or_insert_with(|| frame.clone()) == frame,
