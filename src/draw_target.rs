@@ -455,6 +455,72 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         })
     }
 
+    /// Renders a set-up [`Frame`] tile by tile into a target that takes
+    /// windowed writes: `bins` from [`Frame::bin_tiles`] (or
+    /// [`Frame::bin`]), each tile cleared, drawn from its bin
+    /// ([`Frame::render_tile`]) and pushed as its own rectangle, in tile
+    /// order. The buffers need to hold one tile (`tile_w x tile_h`), not a
+    /// strip: less RAM than strips for the same frame, which is the same
+    /// pixel for pixel. [`Error::BinsMismatch`] (as
+    /// [`DrawError::Render`]) if `bins` were made for another frame.
+    pub fn draw_frame_tiles<T, const S: u32>(
+        &mut self,
+        target: &mut T,
+        frame: &Frame<'_, S>,
+        bins: &crate::Bins<'_>,
+    ) -> Result<RenderStats, DrawError<T::Error>>
+    where
+        T: StripSink<P>,
+    {
+        let tile = bins.tile_width() as usize * bins.strip_rows() as usize;
+        if self.color.len() < tile {
+            return Err(Error::ColorBufferSize {
+                expected: tile,
+                actual: self.color.len(),
+            }
+            .into());
+        }
+        if let Some(actual) = self.depth.held() {
+            if actual < tile {
+                return Err(Error::DepthBufferSize {
+                    expected: tile,
+                    actual,
+                }
+                .into());
+            }
+        }
+        let mut total = RenderStats::default();
+        for t in 0..bins.tiles() {
+            let [x0, x1, y0, y1] = bins.rect(t);
+            let len = (x1 - x0) as usize * (y1 - y0) as usize;
+            let color_len = self.color.len();
+            let Some((color, depth)) = self.color.get_mut(..len).and_then(|color| {
+                let depth = self
+                    .depth
+                    .cleared_with(len, self.clear_z32, color, self.background)?;
+                Some((color, depth))
+            }) else {
+                // Unreachable: both were checked to hold a whole tile.
+                return Err(Error::ColorBufferSize {
+                    expected: len,
+                    actual: color_len,
+                }
+                .into());
+            };
+            let stats = frame.render_tile(bins, t, color, depth)?;
+            total.pixels_written += stats.pixels_written;
+            // Tile corners are below 2^14; saturating keeps an absurd
+            // origin from overflowing.
+            let top = Point::new(
+                self.origin.x.saturating_add(x0 as i32),
+                self.origin.y.saturating_add(y0 as i32),
+            );
+            let area = Rectangle::new(top, Size::new(x1 - x0, y1 - y0));
+            target.push_strip(&area, color).map_err(DrawError::Target)?;
+        }
+        Ok(total)
+    }
+
     /// [`StripDrawer::draw_frame`] for a frame of `N` varyings, coloured
     /// by `fragment` (see [`Frame::render_rows_shaded`]).
     pub fn draw_frame_shaded<T, const S: u32, const N: usize, F>(
@@ -685,6 +751,61 @@ mod tests {
                 .unwrap();
             display.assert_eq_with_message(&expected, |f| write!(f, "shaded frame, {rows} rows"));
         }
+    }
+
+    /// Tiles of several sizes (ragged at the right and bottom, one wider
+    /// than the frame) through [`StripDrawer::draw_frame_tiles`], at an
+    /// offset: every frame pixel written exactly once (MockDisplay panics
+    /// on overdraw), the one-piece render's pixels, buffers of one tile;
+    /// too small a buffer and bins of another frame are errors, nothing
+    /// drawn.
+    #[test]
+    fn tiles_write_every_pixel_once() {
+        let background = Rgb565::BLACK;
+        let origin = Point::new(3, 7);
+        let expected = expected_display(&reference(background), origin);
+        let mut storage = [SetupTriangle::EMPTY; 16];
+        let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
+        scene(|p, c, id| frame.submit_clip_triangle(p, c, id).unwrap());
+        for (tw, th) in [(8, 8), (16, 16), (5, 7), (48, 3), (64, 64), (1, 40)] {
+            let mut offsets = vec![0u32; frame.tiles(tw, th) + 1];
+            let mut items = vec![0u32; frame.tile_bin_entries(tw, th)];
+            let bins = frame.bin_tiles(tw, th, &mut offsets, &mut items).unwrap();
+            let n = (bins.tile_width() * th) as usize;
+            let mut color = vec![background; n];
+            let mut depth = vec![0u16; n];
+            let mut drawer =
+                StripDrawer::new(&mut color, &mut depth[..], background).with_origin(origin);
+            let mut display = MockDisplay::<Rgb565>::new();
+            drawer
+                .draw_frame_tiles(&mut display, &frame, &bins)
+                .unwrap();
+            display.assert_eq_with_message(&expected, |f| write!(f, "tiles {tw}x{th}"));
+            let mut small = vec![background; n - 1];
+            let mut display = MockDisplay::<Rgb565>::new();
+            let r = StripDrawer::new(&mut small, NoDepth, background).draw_frame_tiles(
+                &mut display,
+                &frame,
+                &bins,
+            );
+            assert!(matches!(
+                r,
+                Err(DrawError::Render(Error::ColorBufferSize { .. }))
+            ));
+            assert_eq!(display.affected_area().size, Size::zero());
+        }
+        let mut other_storage = [SetupTriangle::EMPTY; 4];
+        let other: Frame = Frame::new(Config::new(W, H + 1), &mut other_storage).unwrap();
+        let (mut offsets, mut items) = (vec![0u32; 64], vec![0u32; 64]);
+        let bins = other.bin_tiles(16, 16, &mut offsets, &mut items).unwrap();
+        let mut color = vec![background; 256];
+        let mut display = MockDisplay::<Rgb565>::new();
+        let r = StripDrawer::new(&mut color, NoDepth, background).draw_frame_tiles(
+            &mut display,
+            &frame,
+            &bins,
+        );
+        assert!(matches!(r, Err(DrawError::Render(Error::BinsMismatch))));
     }
 
     #[test]
