@@ -57,6 +57,8 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
     cargo clippy -q --release --target "$target" --features no-depth,flat -- -D warnings
     cargo clippy -q --release --target "$target" --features immediate -- -D warnings
     cargo clippy -q --release --target "$target" --features clipless -- -D warnings
+    cargo clippy -q --release --target "$target" --features tiles,inv-w -- -D warnings
+    cargo clippy -q --release --target "$target" --features clipless,inv-w -- -D warnings
     cargo clippy -q --release --target "$target" --features subpixel4,depth-u32,no-i32-edges -- -D warnings
     cargo clippy -q --release --target "$target" --no-default-features --features micromath -- -D warnings
     for v in spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong; do
@@ -225,7 +227,8 @@ done
 # The configuration sweep (cubes, set up once), on the M4F and the M0:
 # the report's eight configurations (subpixel bits 8 / 4, depth u16 / u32,
 # float backend libm / micromath), and from the default S8 u16 libm no
-# depth buffer and the i32 edge fast path off: 10 per board.
+# depth buffer and the i32 edge fast path off, 1/w depth (inv-w) and
+# 32x32 tiles into a windowed display (tiles): 12 per board.
 # "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
 # the default and no-depth runs above are two of them already.
 config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
@@ -240,6 +243,8 @@ configs=(
   "S8 u32 micromath|--no-default-features --features micromath,depth-u32|cubes-u32-micromath|"
   "S4 u32 micromath|--no-default-features --features micromath,subpixel4,depth-u32|cubes-s4-u32-micromath|"
   "S8 u16 libm no-i32-edges|--features no-i32-edges|depth-u16|"
+  "S8 u16 libm inv-w|--features inv-w|inv-w|"
+  "S8 u16 libm tiles 32x32|--features tiles|depth-u16|"
 )
 config_header="| board | configuration | frame | render | rasterization | RAM B |"
 config_rows=()

@@ -39,6 +39,26 @@ pub enum DepthFunc {
     Always,
 }
 
+/// The ordered comparisons the span fast paths are built for, as a const
+/// parameter: `Less`, `LessEqual`, `Greater`, `GreaterEqual`.
+pub(crate) mod cmp {
+    pub const LESS: u8 = 0;
+    pub const LESS_EQUAL: u8 = 1;
+    pub const GREATER: u8 = 2;
+    pub const GREATER_EQUAL: u8 = 3;
+}
+
+/// `new CMP old` for a [`cmp`] constant (resolved at compile time).
+#[inline(always)]
+pub(crate) fn passes<const CMP: u8, T: Ord>(new: T, old: T) -> bool {
+    match CMP {
+        cmp::LESS => new < old,
+        cmp::LESS_EQUAL => new <= old,
+        cmp::GREATER => new > old,
+        _ => new >= old,
+    }
+}
+
 impl DepthFunc {
     /// Whether a fragment at depth `new` passes against `stored`.
     #[inline]
@@ -124,8 +144,9 @@ pub trait DepthBuffer {
         flat_span_each(self, color, start, len, z0, dz, func, write, px)
     }
 
-    /// [`flat_span`](DepthBuffer::flat_span) with `func` `Less` (or
-    /// `LessEqual` when `le`), writes on, `F = 0`, and a depth the caller
+    /// [`flat_span`](DepthBuffer::flat_span) with an ordered `func`
+    /// (`Less`, `LessEqual`, `Greater` or `GreaterEqual`, as the crate's
+    /// `cmp` constant `cmp`), writes on, `F = 0`, and a depth the caller
     /// has proved to stay in `[0, 2^32)` over the span: `z0 + n * dz`
     /// (wrapping `u32` sums of `dz`'s low half) is then the exact `Z32`,
     /// with no clamp. Only called for buffers with
@@ -141,13 +162,14 @@ pub trait DepthBuffer {
         len: usize,
         z0: u32,
         dz: i64,
-        le: bool,
+        cmp: u8,
         px: C,
     ) -> u32 {
-        let func = if le {
-            DepthFunc::LessEqual
-        } else {
-            DepthFunc::Less
+        let func = match cmp {
+            cmp::LESS => DepthFunc::Less,
+            cmp::LESS_EQUAL => DepthFunc::LessEqual,
+            cmp::GREATER => DepthFunc::Greater,
+            _ => DepthFunc::GreaterEqual,
         };
         self.flat_span(color, start, len, z0 as i64, dz, func, true, px)
     }
@@ -197,8 +219,8 @@ fn in_range_throughout(z0: i64, dz: i64, len: usize, frac: u32) -> bool {
     (0..top).contains(&z0) && (0..top).contains(&last)
 }
 
-/// The flat-span loop of [`DepthBuffer::flat_span`] for `Less` (`LE =
-/// false`) or `LessEqual` with writes, where [`in_range_throughout`] holds:
+/// The flat-span loop of [`DepthBuffer::flat_span`] for an ordered
+/// comparison (`CMP`, a [`cmp`] constant) with writes, where [`in_range_throughout`] holds:
 /// `z` is never clamped, so the word is [`DepthWord::from_fixed_in_range`]
 /// of the wrapping sum: a `u64` for `Z32.16` (an add with carry on a 32-bit
 /// core), a `u32` for `Z32.0` (`u16` buffers), exact because every value
@@ -206,7 +228,7 @@ fn in_range_throughout(z0: i64, dz: i64, len: usize, frac: u32) -> bool {
 /// lost its registers to the caller's (on the Cortex-M4F the four-cubes
 /// frame takes 19 k more instructions inlined).
 #[inline(never)]
-fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
+fn span_unclamped<W: DepthWord, C: Copy, const CMP: u8>(
     c: &mut [C],
     d: &mut [W],
     z0: u64,
@@ -215,12 +237,12 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
 ) -> u32 {
     let mut written = 0u32;
     if W::FRAC == 0 {
-        written = z32_loop::<W, C, LE>(c, d, z0 as u32, dz as u32, px);
+        written = z32_loop::<W, C, CMP>(c, d, z0 as u32, dz as u32, px);
     } else {
         let mut z = z0;
         for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
             let (key, old) = (W::key_in_range(z), (*dp).key());
-            if key < old || (LE && key == old) {
+            if passes::<CMP, _>(key, old) {
                 *dp = W::from_fixed_in_range(z);
                 *cp = px;
                 written += 1;
@@ -235,20 +257,20 @@ fn span_unclamped<W: DepthWord, C: Copy, const LE: bool>(
 /// and step in one register each: the loop behind
 /// [`DepthBuffer::flat_span_in_range`] on 32-bit cores.
 #[inline(never)]
-fn span_z32<W: DepthWord, C: Copy, const LE: bool>(
+fn span_z32<W: DepthWord, C: Copy, const CMP: u8>(
     c: &mut [C],
     d: &mut [W],
     z0: u32,
     dz: u32,
     px: C,
 ) -> u32 {
-    z32_loop::<W, C, LE>(c, d, z0, dz, px)
+    z32_loop::<W, C, CMP>(c, d, z0, dz, px)
 }
 
 /// The `Z32.0` span loop itself, shared by [`span_unclamped`] and
 /// [`span_z32`]: `z` in one `u32`, the word its top half.
 #[inline(always)]
-fn z32_loop<W: DepthWord, C: Copy, const LE: bool>(
+fn z32_loop<W: DepthWord, C: Copy, const CMP: u8>(
     c: &mut [C],
     d: &mut [W],
     z0: u32,
@@ -259,7 +281,7 @@ fn z32_loop<W: DepthWord, C: Copy, const LE: bool>(
     let mut z = z0;
     for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
         let (key, old) = (W::key_in_range(z as u64), (*dp).key());
-        if key < old || (LE && key == old) {
+        if passes::<CMP, _>(key, old) {
             *dp = W::from_fixed_in_range(z as u64);
             *cp = px;
             written += 1;
@@ -393,6 +415,87 @@ impl DepthWord for u32 {
     }
 }
 
+/// The host's branch-free `Z32.0` span loop (so the compiler can
+/// vectorize it) for [`DepthBuffer::flat_span_in_range`]: the same
+/// unclamped words as [`z32_loop`].
+#[inline(always)]
+fn z32_branch_free<W: DepthWord, C: Copy, const CMP: u8>(
+    c: &mut [C],
+    d: &mut [W],
+    z0: u32,
+    dz: u32,
+    px: C,
+) -> u32 {
+    let (mut z, mut written) = (z0, 0u32);
+    for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+        let zw = W::from_fixed_in_range(z as u64);
+        let pass = passes::<CMP, _>(zw, *dp);
+        *dp = if pass { zw } else { *dp };
+        *cp = if pass { px } else { *cp };
+        written += pass as u32;
+        z = z.wrapping_add(dz);
+    }
+    written
+}
+
+/// [`DepthBuffer::flat_span`] of a slice under `Greater` (or
+/// `GreaterEqual` when `ge`) with writes, as `Less` spans are drawn:
+/// branch-free on the host, the unclamped loop where
+/// [`in_range_throughout`] holds on 32-bit cores, else word by word. Out
+/// of line, so the `Less` paths inlined into the rasterizer do not grow.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn span_greater<W: DepthWord, C: Copy>(
+    buf: &mut [W],
+    color: &mut [C],
+    start: usize,
+    len: usize,
+    z0: i64,
+    dz: i64,
+    ge: bool,
+    px: C,
+) -> u32 {
+    let end = start.saturating_add(len);
+    let (Some(c), Some(d)) = (color.get_mut(start..end), buf.get_mut(start..end)) else {
+        return 0;
+    };
+    let pass = |zw: W, old: W| {
+        if ge {
+            passes::<{ cmp::GREATER_EQUAL }, _>(zw, old)
+        } else {
+            passes::<{ cmp::GREATER }, _>(zw, old)
+        }
+    };
+    let (mut z, mut written) = (z0, 0u32);
+    if cfg!(target_pointer_width = "64") {
+        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+            let zw = W::from_fixed(z);
+            let p = pass(zw, *dp);
+            *dp = if p { zw } else { *dp };
+            *cp = if p { px } else { *cp };
+            written += p as u32;
+            z = z.wrapping_add(dz);
+        }
+    } else if in_range_throughout(z0, dz, len, W::FRAC) {
+        return if ge {
+            span_unclamped::<W, C, { cmp::GREATER_EQUAL }>(c, d, z0 as u64, dz as u64, px)
+        } else {
+            span_unclamped::<W, C, { cmp::GREATER }>(c, d, z0 as u64, dz as u64, px)
+        };
+    } else {
+        for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
+            let zw = W::from_fixed(z);
+            if pass(zw, *dp) {
+                *dp = zw;
+                *cp = px;
+                written += 1;
+            }
+            z = z.wrapping_add(dz);
+        }
+    }
+    written
+}
+
 /// An `f32` depth word in `[0, 1)`, kept as its IEEE bits (see the module
 /// note): `Z32.16` truncated to 24 significant bits, made and compared
 /// with integer operations only. [`DepthF32::get`] (or `f32::from`) reads
@@ -520,6 +623,10 @@ impl<W: DepthWord> DepthBuffer for [W] {
         write: bool,
         px: C,
     ) -> u32 {
+        if write && matches!(func, DepthFunc::Greater | DepthFunc::GreaterEqual) {
+            let ge = func == DepthFunc::GreaterEqual;
+            return span_greater(self, color, start, len, z0, dz, ge, px);
+        }
         if !(write && matches!(func, DepthFunc::Less | DepthFunc::LessEqual)) {
             return flat_span_each(self, color, start, len, z0, dz, func, write, px);
         }
@@ -546,9 +653,9 @@ impl<W: DepthWord> DepthBuffer for [W] {
             // span's depth never leaves [0, 2^(32 + F)), so no clamp: the
             // word is a shift of `z` (one 32-bit register for `u16`).
             return if le {
-                span_unclamped::<W, C, true>(c, d, z0 as u64, dz as u64, px)
+                span_unclamped::<W, C, { cmp::LESS_EQUAL }>(c, d, z0 as u64, dz as u64, px)
             } else {
-                span_unclamped::<W, C, false>(c, d, z0 as u64, dz as u64, px)
+                span_unclamped::<W, C, { cmp::LESS }>(c, d, z0 as u64, dz as u64, px)
             };
         } else {
             for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
@@ -572,7 +679,7 @@ impl<W: DepthWord> DepthBuffer for [W] {
         len: usize,
         z0: u32,
         dz: i64,
-        le: bool,
+        cmp: u8,
         px: C,
     ) -> u32 {
         debug_assert!(W::FRAC == 0);
@@ -585,23 +692,20 @@ impl<W: DepthWord> DepthBuffer for [W] {
             return 0;
         };
         if cfg!(target_pointer_width = "64") {
-            // Branch-free for the host's vectors, the same unclamped words.
-            let (mut z, dz) = (z0, dz as u32);
-            let mut written = 0u32;
-            for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-                let zw = W::from_fixed_in_range(z as u64);
-                let pass = zw < *dp || (le && zw == *dp);
-                *dp = if pass { zw } else { *dp };
-                *cp = if pass { px } else { *cp };
-                written += pass as u32;
-                z = z.wrapping_add(dz);
-            }
-            return written;
+            return match cmp {
+                cmp::LESS => z32_branch_free::<W, C, { cmp::LESS }>(c, d, z0, dz as u32, px),
+                cmp::LESS_EQUAL => {
+                    z32_branch_free::<W, C, { cmp::LESS_EQUAL }>(c, d, z0, dz as u32, px)
+                }
+                cmp::GREATER => z32_branch_free::<W, C, { cmp::GREATER }>(c, d, z0, dz as u32, px),
+                _ => z32_branch_free::<W, C, { cmp::GREATER_EQUAL }>(c, d, z0, dz as u32, px),
+            };
         }
-        if le {
-            span_z32::<W, C, true>(c, d, z0, dz as u32, px)
-        } else {
-            span_z32::<W, C, false>(c, d, z0, dz as u32, px)
+        match cmp {
+            cmp::LESS => span_z32::<W, C, { cmp::LESS }>(c, d, z0, dz as u32, px),
+            cmp::LESS_EQUAL => span_z32::<W, C, { cmp::LESS_EQUAL }>(c, d, z0, dz as u32, px),
+            cmp::GREATER => span_z32::<W, C, { cmp::GREATER }>(c, d, z0, dz as u32, px),
+            _ => span_z32::<W, C, { cmp::GREATER_EQUAL }>(c, d, z0, dz as u32, px),
         }
     }
 
@@ -661,10 +765,10 @@ impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
         len: usize,
         z0: u32,
         dz: i64,
-        le: bool,
+        cmp: u8,
         px: C,
     ) -> u32 {
-        self[..].flat_span_in_range(color, start, len, z0, dz, le, px)
+        self[..].flat_span_in_range(color, start, len, z0, dz, cmp, px)
     }
 
     fn depth_len(&self) -> Option<usize> {
@@ -734,18 +838,19 @@ mod tests {
     /// pixel-by-pixel loop writes wherever `in_range_throughout` admits a
     /// span, and that test admits only spans whose every value is in
     /// `[0, 2^(32 + F))`.
-    fn unclamped_matches<W: DepthWord>(z0: i64, dz: i64, len: usize, seed: u64, le: bool) {
+    fn unclamped_matches<W: DepthWord>(z0: i64, dz: i64, len: usize, seed: u64, k: u8) {
         let stored: std::vec::Vec<W> = (0..len as u64)
             .map(|n| {
                 let h = (seed ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15);
                 W::from_z32((h >> 32) as u32)
             })
             .collect();
-        let func = if le {
-            DepthFunc::LessEqual
-        } else {
-            DepthFunc::Less
-        };
+        let func = [
+            DepthFunc::Less,
+            DepthFunc::LessEqual,
+            DepthFunc::Greater,
+            DepthFunc::GreaterEqual,
+        ][k as usize % 4];
         let (mut d_ref, mut c_ref) = (stored.clone(), std::vec![0u8; len]);
         let want = flat_span_each(&mut d_ref[..], &mut c_ref, 0, len, z0, dz, func, true, 1u8);
         if !in_range_throughout(z0, dz, len, W::FRAC) {
@@ -758,10 +863,16 @@ mod tests {
             );
         }
         let (mut d, mut c) = (stored, std::vec![0u8; len]);
-        let got = if le {
-            span_unclamped::<W, u8, true>(&mut c, &mut d, z0 as u64, dz as u64, 1)
-        } else {
-            span_unclamped::<W, u8, false>(&mut c, &mut d, z0 as u64, dz as u64, 1)
+        let (z0, dz) = (z0 as u64, dz as u64);
+        let got = match func {
+            DepthFunc::Less => span_unclamped::<W, u8, { cmp::LESS }>(&mut c, &mut d, z0, dz, 1),
+            DepthFunc::LessEqual => {
+                span_unclamped::<W, u8, { cmp::LESS_EQUAL }>(&mut c, &mut d, z0, dz, 1)
+            }
+            DepthFunc::Greater => {
+                span_unclamped::<W, u8, { cmp::GREATER }>(&mut c, &mut d, z0, dz, 1)
+            }
+            _ => span_unclamped::<W, u8, { cmp::GREATER_EQUAL }>(&mut c, &mut d, z0, dz, 1),
         };
         assert_eq!((got, &d, &c), (want, &d_ref, &c_ref));
     }
@@ -780,9 +891,9 @@ mod tests {
             dz in prop_oneof![-(1i64 << 34)..1 << 34, -(1i64 << 42)..1 << 42, -4i64..4, any::<i64>()],
             len in 1usize..300,
             seed in any::<u64>(),
-            le in any::<bool>(),
+            k in 0u8..4,
         ) {
-            unclamped_matches::<u32>(z0, dz, len, seed, le);
+            unclamped_matches::<u32>(z0, dz, len, seed, k);
         }
 
         /// The same for `u16` buffers, whose spans step `Z32.0`: starts
@@ -794,9 +905,9 @@ mod tests {
             dz in prop_oneof![-(1i64 << 34)..1 << 34, -(1i64 << 42)..1 << 42, -4i64..4, any::<i64>()],
             len in 1usize..300,
             seed in any::<u64>(),
-            le in any::<bool>(),
+            k in 0u8..4,
         ) {
-            unclamped_matches::<DepthF32>(z0, dz, len, seed, le);
+            unclamped_matches::<DepthF32>(z0, dz, len, seed, k);
         }
 
         /// `DepthF32` is `z / 2^48` truncated to an `f32` (against the
@@ -828,9 +939,9 @@ mod tests {
             dz in prop_oneof![-(1i64 << 18)..1 << 18, -(1i64 << 26)..1 << 26, -4i64..4, any::<i64>()],
             len in 1usize..300,
             seed in any::<u64>(),
-            le in any::<bool>(),
+            k in 0u8..4,
         ) {
-            unclamped_matches::<u16>(z0, dz, len, seed, le);
+            unclamped_matches::<u16>(z0, dz, len, seed, k);
         }
     }
 

@@ -47,7 +47,8 @@
 //!
 //! A flat triangle's span rows run in a loop of their own (`flat_rows`),
 //! out of line so that only the depth state is live in it. For a `u16`
-//! buffer under `Less` or `LessEqual` with writes, a triangle whose vertex
+//! buffer under an ordered test (`Less`, `LessEqual`, `Greater` for 1/w
+//! depth, `GreaterEqual`) with writes, a triangle whose vertex
 //! depths keep `2^14 + width` `Z32` units from both planes
 //! (`z_never_clamps`, with its error bound) provably never steps a span
 //! out of `[0, 2^32)`: its spans skip the per-span range check and the
@@ -63,7 +64,7 @@
 //! equal varyings is shaded once per strip.
 
 use crate::color::PixelFormat;
-use crate::depth::{DepthBuffer, DepthFunc};
+use crate::depth::{cmp, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use crate::shade::FragmentShader;
 
@@ -1041,18 +1042,25 @@ fn flat_rows<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T
     strip: &mut Strip<'_, C, D>,
     px: C,
 ) -> u32 {
-    if D::ENABLED
-        && D::FRAC == 0
-        && strip.depth_write
-        && matches!(strip.depth_func, DepthFunc::Less | DepthFunc::LessEqual)
-        && z_never_clamps(z, max_n)
-    {
-        let args = (edges, shader, rows, base, max_n);
-        return if strip.depth_func == DepthFunc::LessEqual {
-            flat_rows_in_range::<N, C, D, R, T, true>(args, strip, px)
-        } else {
-            flat_rows_in_range::<N, C, D, R, T, false>(args, strip, px)
+    if D::ENABLED && D::FRAC == 0 && strip.depth_write && z_never_clamps(z, max_n) {
+        let cmp = match strip.depth_func {
+            DepthFunc::Less => Some(cmp::LESS),
+            DepthFunc::LessEqual => Some(cmp::LESS_EQUAL),
+            DepthFunc::Greater => Some(cmp::GREATER),
+            DepthFunc::GreaterEqual => Some(cmp::GREATER_EQUAL),
+            _ => None,
         };
+        let args = (edges, shader, rows, base, max_n);
+        // `Less`, the default, with its test folded in; the others share
+        // one copy that picks each span's loop (flash over a few
+        // instructions a span).
+        match cmp {
+            Some(cmp::LESS) => {
+                return flat_rows_in_range::<N, C, D, R, T, true>(args, strip, cmp::LESS, px)
+            }
+            Some(cmp) => return flat_rows_in_range::<N, C, D, R, T, false>(args, strip, cmp, px),
+            None => {}
+        }
     }
     let mut written = 0u32;
     let mut spans = RowSpans::new(&edges, max_n);
@@ -1114,7 +1122,9 @@ fn z_never_clamps(z: [u32; 3], max_n: usize) -> bool {
 }
 
 /// [`flat_rows`] where [`z_never_clamps`] holds for a `Z32.0` buffer
-/// under `Less` or `LessEqual` with writes: the span's start is converted
+/// under an ordered test (`cmp`, a `depth::cmp` constant; `LESS` folds
+/// in `Less`, the default, and otherwise one copy serves the other three,
+/// each span's loop picked by `cmp`) with writes: the span's start is converted
 /// straight to `u32` (`to_fixed` gives the same integer for a value in
 /// range) and every span goes to the unclamped loop.
 fn flat_rows_in_range<
@@ -1123,12 +1133,14 @@ fn flat_rows_in_range<
     D: DepthBuffer + ?Sized,
     R: Real,
     T: EdgeInt,
-    const LE: bool,
+    const LESS: bool,
 >(
     (mut edges, shader, rows, mut base, max_n): ([Edge<T>; 3], &Shader<R, N>, u32, usize, usize),
     strip: &mut Strip<'_, C, D>,
+    cmp: u8,
     px: C,
 ) -> u32 {
+    let cmp = if LESS { cmp::LESS } else { cmp };
     let mut written = 0u32;
     let mut spans = RowSpans::new(&edges, max_n);
     for _ in 0..rows {
@@ -1141,7 +1153,7 @@ fn flat_rows_in_range<
                 hi - lo + 1,
                 z0.round_in_range(),
                 shader.dz_fixed,
-                LE,
+                cmp,
                 px,
             );
         }

@@ -1202,7 +1202,8 @@ proptest! {
     /// The `u16` span path that skips the per-span range check (`Less`,
     /// writes on, vertex depths clear of the planes: `z_never_clamps` in
     /// `src/raster.rs`) writes the depths the clamped per-pixel path writes
-    /// (`Always`, which never takes it), for flat triangles with depths
+    /// (`Always`, which never takes it), under each ordered test it is
+    /// built for, for flat triangles with depths
     /// near both planes and in between. (Debug builds also assert, per
     /// span, that the unchecked spans stay in range.)
     #[test]
@@ -1215,27 +1216,36 @@ proptest! {
             p.z = z * p.w;
         }
         let n = (w * h) as usize;
-        let depth = |func| {
+        let depth = |func, clear| {
             let mut cfg = config_nocull(w, h);
             cfg.depth_func = func;
             let mut st = storage(1);
             let mut frame = Frame::<8>::with_subpixel_bits(cfg, &mut st).unwrap();
             frame.submit_clip_triangle(pos, [Rgb888::new(9, 8, 7); 3], 0).unwrap();
             let mut c = vec![Rgb888::new(0, 0, 0); n];
-            let mut z = vec![u16::MAX; n];
+            let mut z = vec![clear; n];
             frame.render_rows(0, h, &mut c[..], &mut z[..]).unwrap();
             (c, z)
         };
-        let (less_c, less_z) = depth(DepthFunc::Less);
-        let (all_c, all_z) = depth(DepthFunc::Always);
-        for k in 0..n {
-            // `Less` against the far clear fails only where the depth is
-            // the far plane itself.
-            if all_z[k] != u16::MAX {
-                prop_assert_eq!(less_z[k], all_z[k], "depth at pixel {}", k);
-                prop_assert_eq!(less_c[k], all_c[k], "colour at pixel {}", k);
-            } else {
-                prop_assert_eq!(less_z[k], u16::MAX);
+        // Every ordered test against the clear it passes everywhere but at
+        // the clear value itself (`Greater` and `GreaterEqual` as 1/w
+        // depth draws them, cleared to 0).
+        for (func, clear) in [
+            (DepthFunc::Less, u16::MAX),
+            (DepthFunc::LessEqual, u16::MAX),
+            (DepthFunc::Greater, 0),
+            (DepthFunc::GreaterEqual, 0),
+        ] {
+            let (fast_c, fast_z) = depth(func, clear);
+            let (all_c, all_z) = depth(DepthFunc::Always, clear);
+            let equal_passes = matches!(func, DepthFunc::LessEqual | DepthFunc::GreaterEqual);
+            for k in 0..n {
+                if all_z[k] != clear || equal_passes {
+                    prop_assert_eq!(fast_z[k], all_z[k], "{:?}: depth at pixel {}", func, k);
+                    prop_assert_eq!(fast_c[k], all_c[k], "{:?}: colour at pixel {}", func, k);
+                } else {
+                    prop_assert_eq!(fast_z[k], clear);
+                }
             }
         }
     }

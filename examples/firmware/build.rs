@@ -159,6 +159,30 @@ fn frame_checksum(pixels: &[Rgb565]) -> u64 {
     c.value()
 }
 
+/// The cubes' frame settings and their matrices, with the same callback
+/// as `cubes::for_each_cube`: window z, or with `inv-w` 1/w depth
+/// (`DepthFunc::Greater`).
+#[cfg(not(feature = "spot"))]
+fn cubes_config(
+    mut draw: impl FnMut(&microraster::Mesh<'static>, &microraster::Mat4, u32),
+) -> Config {
+    let mut config = Config::new(WIDTH, HEIGHT);
+    let mvps = if cfg!(feature = "inv-w") {
+        config.depth_func = microraster::DepthFunc::Greater;
+        cubes::mvps_inv_w(WIDTH, HEIGHT)
+    } else {
+        cubes::mvps(WIDTH, HEIGHT)
+    };
+    for (i, mvp) in mvps.iter().enumerate() {
+        draw(&cubes::MESH, mvp, (i * cubes::CUBE_INDICES.len()) as u32);
+    }
+    config
+}
+
+/// The depth buffer's clear value as a `Z32` (0 for 1/w depth).
+#[cfg(not(feature = "spot"))]
+const CLEAR_Z32: u32 = if cfg!(feature = "inv-w") { 0 } else { u32::MAX };
+
 #[cfg(not(feature = "spot"))]
 fn host_checksum(depth: bool) -> u64 {
     if cfg!(feature = "clipless") {
@@ -166,18 +190,16 @@ fn host_checksum(depth: bool) -> u64 {
     }
     let mut storage = vec![SetupTriangle::EMPTY; cubes::CUBE_INDICES.len() * 4 * 7];
     const S: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
-    let mut frame =
-        Frame::<S>::with_subpixel_bits(Config::new(WIDTH, HEIGHT), &mut storage).unwrap();
-    cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| {
-        frame.submit_mesh(mesh, mvp, id).unwrap()
-    });
+    let config = cubes_config(|_, _, _| {});
+    let mut frame = Frame::<S>::with_subpixel_bits(config, &mut storage).unwrap();
+    cubes_config(|mesh, mvp, id| frame.submit_mesh(mesh, mvp, id).unwrap());
     let n = (WIDTH * HEIGHT) as usize;
     let mut color = vec![Rgb565::BLACK; n];
     if depth && cfg!(feature = "depth-u32") {
-        let mut z = vec![u32::MAX; n];
+        let mut z = vec![CLEAR_Z32; n];
         frame.render_rows(0, HEIGHT, &mut color, &mut z[..])
     } else if depth {
-        let mut z = vec![u16::MAX; n];
+        let mut z = vec![(CLEAR_Z32 >> 16) as u16; n];
         frame.render_rows(0, HEIGHT, &mut color, &mut z[..])
     } else {
         frame.render_rows(0, HEIGHT, &mut color, &mut NoDepth)
@@ -189,14 +211,14 @@ fn host_checksum(depth: bool) -> u64 {
 /// The cubes in the clipless mode, drawn whole by one strip renderer.
 #[cfg(not(feature = "spot"))]
 fn clipless_checksum(depth: bool) -> u64 {
-    let mut config = Config::new(WIDTH, HEIGHT);
+    let mut config = cubes_config(|_, _, _| {});
     config.mode = microraster::RasterMode::Clipless;
     let n = (WIDTH * HEIGHT) as usize;
     let mut color = vec![Rgb565::BLACK; n];
-    let mut z = vec![u16::MAX; n];
+    let mut z = vec![(CLEAR_Z32 >> 16) as u16; n];
     let mut none = NoDepth;
     let draw = |strip: &mut dyn FnMut(&microraster::Mesh<'_>, &microraster::Mat4, u32)| {
-        cubes::for_each_cube(WIDTH, HEIGHT, |mesh, mvp, id| strip(mesh, mvp, id));
+        cubes_config(|mesh, mvp, id| strip(mesh, mvp, id));
     };
     if depth {
         let mut r =

@@ -36,6 +36,20 @@ impl FrameChecksum {
         self.b = self.b.wrapping_add(self.a);
     }
 
+    /// Adds word `index` of a frame of `words` words, in any order: after
+    /// every word of the frame has been added once, the value is the one
+    /// [`push_word`](FrameChecksum::push_word) gives in order. (The second
+    /// sum of words `w_0 .. w_{n-1}` in order is `sum (n - i) w_i`, so a
+    /// word's share depends only on its place.) For a display that takes
+    /// windowed writes, e.g. tiles; do not mix with the in-order methods.
+    #[inline(always)]
+    pub fn add_word_at(&mut self, w: u32, index: u32, words: u32) {
+        self.a = self.a.wrapping_add(w);
+        self.b = self
+            .b
+            .wrapping_add(words.wrapping_sub(index).wrapping_mul(w));
+    }
+
     /// Adds one pixel's raw 16 bits.
     #[inline]
     pub fn push(&mut self, px: u16) {
@@ -84,5 +98,31 @@ mod tests {
         e.extend([1u16, 2, 3, 0]);
         assert_eq!(d.value(), e.value());
         assert_eq!(FrameChecksum::new().value(), 0);
+    }
+
+    #[test]
+    fn words_at_their_places_in_any_order_give_the_in_order_value() {
+        let words: [u32; 7] = [1, 0xdead_beef, 3, u32::MAX, 0x8000_0000, 42, 7];
+        let mut in_order = FrameChecksum::new();
+        for &w in &words {
+            in_order.push_word(w);
+        }
+        for order in [
+            [0, 1, 2, 3, 4, 5, 6],
+            [6, 5, 4, 3, 2, 1, 0],
+            [3, 0, 6, 1, 5, 2, 4],
+        ] {
+            let mut c = FrameChecksum::new();
+            for i in order {
+                c.add_word_at(words[i], i as u32, words.len() as u32);
+            }
+            assert_eq!(c.value(), in_order.value());
+        }
+        // A word at another place gives another value.
+        let mut c = FrameChecksum::new();
+        for (i, &w) in words.iter().enumerate() {
+            c.add_word_at(w, (i as u32 + 1) % 7, 7);
+        }
+        assert_ne!(c.value(), in_order.value());
     }
 }

@@ -209,6 +209,22 @@ pub fn mvps(width: u32, height: u32) -> [Mat4; 4] {
     CUBE_MODELS.map(|ops| vp * model_matrix(&ops))
 }
 
+/// [`view_projection`] with 1/w depth (`Mat4::perspective_inv_w`: window
+/// depth `near / w`, draw with `DepthFunc::Greater` into a depth buffer
+/// cleared to 0; no far plane).
+pub fn view_projection_inv_w(width: u32, height: u32) -> Mat4 {
+    let aspect = width as f32 / height as f32;
+    let proj = Mat4::perspective_inv_w(radians(CUBES_FOV_Y_DEG), aspect, CUBES_NEAR);
+    let v = Vec3::from_array;
+    proj * Mat4::look_at(v(CUBES_EYE), v(CUBES_TARGET), v(CUBES_UP))
+}
+
+/// [`mvps`] with 1/w depth ([`view_projection_inv_w`]).
+pub fn mvps_inv_w(width: u32, height: u32) -> [Mat4; 4] {
+    let vp = view_projection_inv_w(width, height);
+    CUBE_MODELS.map(|ops| vp * model_matrix(&ops))
+}
+
 /// Calls `draw(mesh, mvp, first_id)` for each cube in drawing order; the
 /// triangle ids run 0..48. Works with `Submit::submit_mesh` on a `Frame`
 /// and a `StripRenderer` alike.

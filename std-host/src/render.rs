@@ -465,7 +465,12 @@ mod tests {
     #[test]
     fn cubes_identical_for_any_threads_and_strips() {
         let scene = cubes_scene(&View::new(160, 120)).unwrap();
-        for depth in [DepthKind::U16, DepthKind::U32, DepthKind::None] {
+        for depth in [
+            DepthKind::U16,
+            DepthKind::U32,
+            DepthKind::F32,
+            DepthKind::None,
+        ] {
             let base = render(&scene, &opts(1, 120, depth)).unwrap();
             assert!(base.pixels_written > 1000);
             for (t, r) in [(1, 1), (2, 7), (3, 16), (2, 1000), (4, 3)] {
@@ -511,6 +516,43 @@ mod tests {
         }
         assert_eq!(r.stats.culled_backface, back);
         assert_eq!(r.stats.stored, 48 - back);
+    }
+
+    /// An `f32` buffer gives the `u32` buffer's image and its depths to
+    /// 24 significant bits, set up once or in strips (`--mode clipless`),
+    /// for window z and 1/w; `--depth-out` writes them as `f32`.
+    #[test]
+    fn f32_depth_matches_u32() {
+        for inv_w in [false, true] {
+            let view = View {
+                inv_w,
+                ..View::new(160, 120)
+            };
+            let scene = cubes_scene(&view).unwrap();
+            for mode in [RasterMode::Clipping, RasterMode::Clipless] {
+                let o = |depth| RenderOptions {
+                    mode,
+                    inv_w,
+                    ..opts(2, 16, depth)
+                };
+                let a = render(&scene, &o(DepthKind::U32)).unwrap();
+                let b = render(&scene, &o(DepthKind::F32)).unwrap();
+                assert_eq!((&a.rgb, &a.ids), (&b.rgb, &b.ids), "{mode:?} {inv_w}");
+                let (DepthImage::U32(u), DepthImage::F32(f)) = (&a.depth, &b.depth) else {
+                    panic!("depth kinds");
+                };
+                for (&u, &f) in u.iter().zip(f) {
+                    let (u, f) = (u as f64, f.get() as f64 * 4_294_967_296.0);
+                    assert!((u - f).abs() <= (u / 8_388_608.0).max(1.0), "{u} {f}");
+                }
+                let bytes = b.depth.to_le_bytes();
+                assert_eq!(bytes.len(), 4 * f.len());
+                assert_eq!(
+                    f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]),
+                    f[0].get()
+                );
+            }
+        }
     }
 
     fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

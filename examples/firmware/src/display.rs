@@ -11,6 +11,14 @@
 //! the wire. The checksum of a frame does not depend on how it was cut
 //! into strips (rows are an even number of pixels wide). The instructions
 //! it spends are counted apart, on their own line.
+//!
+//! With the `tiles` feature it stands in for a display that takes
+//! windowed writes instead: any rectangle inside the frame (an even
+//! column and width, so pixels pair into words as they do in rows), in
+//! any order, each word added to the checksum at its place in the frame
+//! (`FrameChecksum::add_word_at`: the same value as rows in order, one
+//! multiply more a word). The frame is complete when its pixel count has
+//! arrived; overdraw or gaps change the checksum.
 
 use crate::clock::Clock;
 use embedded_graphics_core::geometry::{OriginDimensions, Size};
@@ -30,6 +38,7 @@ pub enum DisplayError {
 /// A `width x height` Rgb565 display that checksums the frame it is sent.
 pub struct HashDisplay {
     size: Size,
+    /// Rows received in order; with `tiles`, pixels received.
     next_row: u32,
     sum: FrameChecksum,
     /// Rectangles received.
@@ -54,7 +63,12 @@ impl HashDisplay {
 
     /// The hash of the frame, once every row has arrived.
     pub fn checksum(&self) -> Option<u64> {
-        (self.next_row == self.size.height).then(|| self.sum.value())
+        let whole = if cfg!(feature = "tiles") {
+            self.size.width * self.size.height
+        } else {
+            self.size.height
+        };
+        (self.next_row == whole).then(|| self.sum.value())
     }
 }
 
@@ -74,6 +88,42 @@ where
 
     /// Takes the strip buffer itself, as a DMA-driven driver does: no
     /// per-pixel iterator, two pixels loaded and summed a word.
+    #[cfg(feature = "tiles")]
+    #[inline(never)]
+    fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), DisplayError> {
+        let start = self.clock.now();
+        let (w, h) = (area.size.width, area.size.height);
+        let (x0, y0) = (area.top_left.x as u32, area.top_left.y as u32);
+        if area.top_left.x < 0
+            || area.top_left.y < 0
+            || x0 % 2 != 0
+            || w % 2 != 0
+            || x0 + w > self.size.width
+            || y0 + h > self.size.height
+            || pixels.len() != (w * h) as usize
+        {
+            return Err(DisplayError::OutOfOrder);
+        }
+        let words = self.size.width * self.size.height / 2;
+        let mut sum = self.sum;
+        for (r, row) in pixels.chunks_exact(w as usize).enumerate() {
+            let first = ((y0 + r as u32) * self.size.width + x0) / 2;
+            for (index, p) in (first..).zip(row.chunks_exact(2)) {
+                let (lo, hi): (u16, u16) = (
+                    Rgb565::from(p[0]).into_storage(),
+                    Rgb565::from(p[1]).into_storage(),
+                );
+                sum.add_word_at(lo as u32 | (hi as u32) << 16, index, words);
+            }
+        }
+        self.sum = sum;
+        self.next_row += w * h;
+        self.pushes += 1;
+        self.ticks += self.clock.now() - start;
+        Ok(())
+    }
+
+    #[cfg(not(feature = "tiles"))]
     #[inline(never)]
     fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), DisplayError> {
         let start = self.clock.now();

@@ -86,6 +86,8 @@ use microraster::{Config, ProcessedVertex, StripDrawer, Submit};
 use microraster_scenes::cubes;
 use panic_semihosting as _;
 
+#[cfg(all(feature = "tiles", any(feature = "immediate", feature = "spot")))]
+compile_error!("`tiles` is for the cubes set up once (not `immediate`, `clipless` or `spot-*`)");
 #[cfg(all(feature = "subpixel4", any(feature = "immediate", feature = "spot")))]
 compile_error!("`subpixel4` is for the cubes set up once (not `immediate` or `spot-*`)");
 #[cfg(all(feature = "depth-u32", any(feature = "no-depth", feature = "spot")))]
@@ -109,6 +111,21 @@ include!(concat!(env!("OUT_DIR"), "/board.rs"));
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
+/// Tiles (`tiles`): 32x32 pixels, 10x8 of them (the bottom row 16 high).
+#[cfg(feature = "tiles")]
+const TILE: u32 = 32;
+#[cfg(feature = "tiles")]
+const TILES: usize = (WIDTH.div_ceil(TILE) * HEIGHT.div_ceil(TILE)) as usize;
+/// Bin entries: one per (stored triangle, tile its box touches); the
+/// four cubes need 130 (checked each frame: binning fails if they do not
+/// fit).
+#[cfg(feature = "tiles")]
+const BIN_ITEMS: usize = 256;
+/// Pixels the colour and depth buffers hold: one tile (`tiles`) or one
+/// strip.
+#[cfg(feature = "tiles")]
+const STRIP_LEN: usize = (TILE * TILE) as usize;
+#[cfg(not(feature = "tiles"))]
 const STRIP_LEN: usize = WIDTH as usize * STRIP_ROWS;
 /// Set-up triangles the frame can hold: the four cubes' 48 triangles,
 /// of which at most half face the camera (the rest are culled as back
@@ -242,6 +259,10 @@ fn main() -> ! {
     static mut SETUP: [SetupTriangle; SETUP_CAPACITY] = [SetupTriangle::EMPTY; SETUP_CAPACITY];
     #[cfg(not(feature = "no-depth"))]
     static mut DEPTH: [DepthWord; STRIP_LEN] = [0; STRIP_LEN];
+    #[cfg(feature = "tiles")]
+    static mut OFFSETS: [u32; TILES + 1] = [0; TILES + 1];
+    #[cfg(feature = "tiles")]
+    static mut ITEMS: [u32; BIN_ITEMS] = [0; BIN_ITEMS];
 
     let p = cortex_m::Peripherals::take().unwrap();
     let mut clock = Clock::start(p.SYST);
@@ -258,14 +279,23 @@ fn main() -> ! {
     {
         config.mode = microraster::RasterMode::Clipless;
     }
-    let mut drawer = StripDrawer::new(&mut COLOR[..], depth, BLACK);
+    #[cfg(feature = "inv-w")]
+    {
+        config.depth_func = microraster::DepthFunc::Greater;
+    }
+    // 1/w depth clears to 0 (the farthest), window z to the far plane.
+    let clear_z32 = if cfg!(feature = "inv-w") { 0 } else { u32::MAX };
+    let mut drawer = StripDrawer::new(&mut COLOR[..], depth, BLACK).with_clear_depth(clear_z32);
     let mut display = HashDisplay::new(WIDTH, HEIGHT, clock);
 
     // The frame: camera matrices and the vertex stage, (in set-up-once
     // mode) every triangle set up into the frame's storage, then every
     // strip.
     let t0 = display.clock.now();
+    #[cfg(not(feature = "inv-w"))]
     let mvps = cubes::mvps(WIDTH, HEIGHT);
+    #[cfg(feature = "inv-w")]
+    let mvps = cubes::mvps_inv_w(WIDTH, HEIGHT);
     process(config, &mvps, VERTICES);
     let vertices: &Vertices = VERTICES;
     #[cfg(feature = "immediate")]
@@ -290,8 +320,28 @@ fn main() -> ! {
                 exit(false)
             }
         }
-        let setup_ticks = display.clock.now() - t0;
-        (drawer.draw_frame(&mut display, &frame), setup_ticks)
+        #[cfg(not(feature = "tiles"))]
+        let drawn = {
+            let setup_ticks = display.clock.now() - t0;
+            (drawer.draw_frame(&mut display, &frame), setup_ticks)
+        };
+        // Binning is part of the frame's setup.
+        #[cfg(feature = "tiles")]
+        let drawn = {
+            let bins = match frame.bin_tiles(TILE, TILE, &mut OFFSETS[..], &mut ITEMS[..]) {
+                Ok(b) => b,
+                Err(e) => {
+                    hprintln!("FAIL: binning: {}", e);
+                    exit(false)
+                }
+            };
+            let setup_ticks = display.clock.now() - t0;
+            (
+                drawer.draw_frame_tiles(&mut display, &frame, &bins),
+                setup_ticks,
+            )
+        };
+        drawn
     };
     let frame_ticks = display.clock.now() - t0;
 
@@ -319,9 +369,25 @@ fn main() -> ! {
     // Measuring with `draw_frame` instead would give it a second call site
     // and change how the frame itself compiles.)
     let mut empty = HashDisplay::new(WIDTH, HEIGHT, display.clock);
-    let t = empty.clock.now();
-    let _ = drawer.draw(&mut empty, config, |_| {});
-    let clear_ticks = (empty.clock.now() - t) - empty.ticks;
+    #[cfg(not(feature = "tiles"))]
+    let clear_ticks = {
+        let t = empty.clock.now();
+        let _ = drawer.draw(&mut empty, config, |_| {});
+        (empty.clock.now() - t) - empty.ticks
+    };
+    // Tiles: an empty frame through the same tiles (each cleared, its
+    // empty bin drawn, pushed), less its pushes.
+    #[cfg(feature = "tiles")]
+    let clear_ticks = {
+        let none = microraster::Frame::<SUBPIXEL>::with_subpixel_bits(config, &mut []);
+        let t = empty.clock.now();
+        if let Ok(none) = none {
+            if let Ok(bins) = none.bin_tiles(TILE, TILE, &mut OFFSETS[..], &mut ITEMS[..]) {
+                let _ = drawer.draw_frame_tiles(&mut empty, &none, &bins);
+            }
+        }
+        (empty.clock.now() - t) - empty.ticks
+    };
     #[cfg(not(feature = "immediate"))]
     let geometry_ticks = setup_ticks;
     #[cfg(feature = "immediate")]
@@ -347,8 +413,13 @@ fn main() -> ! {
     let raster = render - clears - geometry;
     let per_px = |n: u64| ratio(n, written);
 
+    // How the frame is cut: strips of STRIP_ROWS rows, or tiles.
+    #[cfg(feature = "tiles")]
+    let (pieces, piece) = (TILES as u64, ("tiles of", TILE, "x32 pixels"));
+    #[cfg(not(feature = "tiles"))]
+    let (pieces, piece) = (strips, ("strips of", STRIP_ROWS as u32, " rows"));
     hprintln!(
-        "microraster firmware: {} ({}), {}x{} Rgb565, depth {}, colour {}, {}, {} strips of {} rows",
+        "microraster firmware: {} ({}), {}x{} Rgb565, depth {}, colour {}, {}, {} {} {}{}",
         BOARD,
         CORE,
         WIDTH,
@@ -370,8 +441,10 @@ fn main() -> ! {
         } else {
             "set up once"
         },
-        strips,
-        STRIP_ROWS,
+        pieces,
+        piece.0,
+        piece.1,
+        piece.2,
     );
     hprintln!(
         "configuration: subpixel {}, math {}, i32 edge fast path {}",

@@ -177,10 +177,15 @@ mod tests {
         let rows = table().unwrap();
         for c in CONFIGURATIONS {
             let n = counts(&rows, &c);
-            // The firmware draws the grid, and immediate mode and the
-            // clipless mode with u16 depth; not 1/w depth or tiles.
+            // The firmware draws the grid, immediate mode, and with u16
+            // depth the clipless mode, 1/w depth and 32x32 tiles; not
+            // u32 or f32 1/w, u32 clipless or other tile sizes.
+            let u16 = c.depth_bits == 16 && !c.float_depth;
             let recorded = matches!(c.variant, Variant::Base | Variant::Immediate)
-                || (c.variant == Variant::Clipless && c.depth_bits == 16);
+                || (matches!(
+                    c.variant,
+                    Variant::Clipless | Variant::InvW | Variant::Tiles(32)
+                ) && u16);
             if !recorded {
                 assert!(
                     n.m4f_render.is_none() && n.m0_render.is_none(),
