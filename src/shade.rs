@@ -153,6 +153,19 @@ pub trait FragmentShader<const N: usize> {
     }
 }
 
+/// A shader by reference (e.g. one shared by the strip renderers of many
+/// threads): the same colours.
+impl<const N: usize, F: FragmentShader<N> + ?Sized> FragmentShader<N> for &F {
+    #[inline(always)]
+    fn shade(&self, v: &[f32; N], id: u32) -> Rgb888 {
+        (**self).shade(v, id)
+    }
+    #[inline(always)]
+    fn shade_flat(&self, v: &[f32; N], rgb: Rgb888, id: u32) -> Rgb888 {
+        (**self).shade_flat(v, rgb, id)
+    }
+}
+
 /// The varyings are the colour: red, green, blue in `0.0..=255.0`
 /// (rounded to nearest). The default shader; flat and Gouraud shading,
 /// lit per vertex when the attributes are [`LitColors`].

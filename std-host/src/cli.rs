@@ -29,7 +29,7 @@ use crate::image_out::{image_format, MAX_DIMENSION};
 pub const SCENES: [&str; 5] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad"];
 
 /// The scenes of `report speed-vs-error`, in order.
-pub const REPORT_SCENES: [&str; 4] = ["cubes", "spot", "teapot", "bunny"];
+pub const REPORT_SCENES: [&str; 5] = ["cubes", "spot", "teapot", "bunny", "layers"];
 
 /// Largest `--threads` value accepted.
 pub const MAX_THREADS: usize = 1024;
@@ -575,7 +575,8 @@ pub struct ReportArgs {
     pub reps: Option<u32>,
 
     /// Scenes to run, comma-separated (default: all of cubes, spot, teapot,
-    /// bunny).
+    /// bunny, layers: pairs of close parallel surfaces, for depth-test
+    /// flips).
     #[arg(long, value_name = "LIST", value_delimiter = ',',
           value_parser = clap::builder::PossibleValuesParser::new(REPORT_SCENES))]
     pub scenes: Option<Vec<String>>,

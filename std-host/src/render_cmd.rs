@@ -391,16 +391,13 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     };
     if opts.inv_w {
         if args.depth == DepthArg::None {
-            return Err("--depth-kind inv-w needs a depth buffer (--depth u16 or u32)".to_string());
+            return Err(
+                "--depth-kind inv-w needs a depth buffer (--depth u16, u32 or f32)".to_string(),
+            );
         }
         match args.source() {
             Source::Scene(_) => {}
-            Source::Obj(_) => {
-                return Err(
-                    "--depth-kind inv-w is not yet supported with --obj (lit models); use --scene"
-                        .to_string(),
-                )
-            }
+            Source::Obj(_) => {}
             Source::ClipTris(_) => {
                 return Err(
                     "--depth-kind inv-w needs a camera: --clip-tris gives its own clip-space z"
@@ -414,12 +411,6 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             return Err(
                 "--cull-clusters is not yet supported with --obj (lit models); \
                  use --scene, or `microraster bench --obj FILE --cull-clusters TEST`"
-                    .to_string(),
-            )
-        }
-        Source::Obj(_) if opts.mode == microraster::RasterMode::Clipless => {
-            return Err(
-                "--mode clipless is not yet supported with --obj (lit models); use --scene or --clip-tris"
                     .to_string(),
             )
         }

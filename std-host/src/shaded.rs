@@ -38,8 +38,8 @@ use microraster::shade::{
 };
 use microraster::{
     Attributes, BoundingSphere, Config, DepthWord, Error, FragmentShader, Frame, Mat4, Mesh,
-    MeshColors, NoDepth, PixelFormat, ProcessedVertex, SetupTriangle, Stats, TriangleId, Vec3,
-    VertexColor,
+    MeshColors, NoDepth, PixelFormat, ProcessedVertex, RasterMode, SetupTriangle, Stats,
+    TriangleId, Vec3, VertexColor,
 };
 use std::time::Instant;
 
@@ -160,8 +160,9 @@ fn world_lighting(camera: &Camera, light: [f32; 3]) -> Result<Lighting, String> 
 }
 
 /// The clip-space transform of `model` seen by `camera`, with near and
-/// far planes around its bounding sphere.
-fn mvp(model: &ShadedModel, camera: &Camera, aspect: f32) -> Result<Mat4, String> {
+/// far planes around its bounding sphere (with `inv_w`, 1/w depth from
+/// the same near plane: `Mat4::perspective_inv_w`, no far plane).
+fn mvp(model: &ShadedModel, camera: &Camera, aspect: f32, inv_w: bool) -> Result<Mat4, String> {
     let view = look_at(camera.eye, camera.target)?;
     let bounds = BoundingSphere::from_points(&model.positions);
     let (eye, target) = (
@@ -172,7 +173,8 @@ fn mvp(model: &ShadedModel, camera: &Camera, aspect: f32) -> Result<Mat4, String
     let radius = bounds.map(|b| b.radius).unwrap_or(1.0);
     let near = (dist - 2.0 * radius).max(dist * 0.01).max(1e-4);
     let far = (dist + 2.0 * radius).max(near * 2.0);
-    Ok(Mat4::perspective(radians(camera.fov_y_deg), aspect, near, far) * view)
+    let fov = radians(camera.fov_y_deg);
+    Ok(crate::scene::projection(inv_w, fov, aspect, near, far) * view)
 }
 
 /// Diffuse colours lit per triangle with its face normal.
@@ -223,7 +225,7 @@ fn render_s<const S: u32>(
 ) -> Result<Rendered, String> {
     // The camera first: its errors (eye at the target) are not the light's.
     let aspect = opts.width as f32 / opts.height as f32;
-    let mvp = mvp(model, camera, aspect)?;
+    let mvp = mvp(model, camera, aspect, opts.inv_w)?;
     let lighting = world_lighting(camera, shading.light)?;
     let texels;
     let texture = match (&model.texture, &model.uvs, shading.texture) {
@@ -321,7 +323,7 @@ impl Job<'_> {
         fragment: &F,
     ) -> Result<Rendered, String>
     where
-        A: Attributes<N>,
+        A: Attributes<N> + Sync,
         F: FragmentShader<N> + Sync,
     {
         let (model, opts) = (self.model, self.opts);
@@ -329,6 +331,9 @@ impl Job<'_> {
         let mut config = Config::new(w, h);
         config.cull = opts.cull;
         config.detail = opts.detail;
+        if opts.inv_w {
+            config.depth_func = microraster::DepthFunc::Greater;
+        }
         let mesh = Mesh {
             positions: &model.positions,
             indices: &model.indices,
@@ -337,6 +342,30 @@ impl Job<'_> {
         };
         let t0 = Instant::now();
         let mut cache = vec![ProcessedVertex::EMPTY; model.positions.len()];
+        if opts.mode == RasterMode::Clipless {
+            // No frame (it stores snapped triangles only): the vertices
+            // processed once, the mesh submitted again to a strip renderer
+            // per strip or tile.
+            config.mode = RasterMode::Clipless;
+            let (mut row, mut none) = (vec![BACKGROUND; w as usize], NoDepth);
+            let probe = microraster::StripRenderer::<_, _, S, N, &F>::with_shader(
+                config, 0, 1, &mut row, &mut none, fragment,
+            )
+            .map_err(|e| e.to_string())?;
+            probe.process_vertices(self.mvp, &model.positions, &mut cache);
+            let stats = std::sync::Mutex::new(Stats::default());
+            let src = Immediate::<S, N, A, F> {
+                config,
+                mesh: &mesh,
+                cache: &cache,
+                fragment,
+                stats: &stats,
+            };
+            let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+            return self.draw_all(&src, setup_ms, || {
+                stats.lock().map(|s| *s).unwrap_or_default()
+            });
+        }
         let mut capacity = Frame::<S>::storage_for(model.indices.len());
         let mut storage;
         let frame = loop {
@@ -351,27 +380,42 @@ impl Job<'_> {
         };
         let stats: Stats = frame.stats();
         let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
+        self.draw_all(
+            &SetUp {
+                frame: &frame,
+                fragment,
+            },
+            setup_ms,
+            || stats,
+        )
+    }
+
+    /// Draws the colour image (and the id image if asked) from `src`;
+    /// `stats` gives the counters once the colour image is drawn.
+    fn draw_all<R>(
+        &self,
+        src: &R,
+        setup_ms: f64,
+        stats: impl FnOnce() -> Stats,
+    ) -> Result<Rendered, String>
+    where
+        R: DrawRect<Rgb888> + DrawRect<TriangleId>,
+    {
+        let opts = self.opts;
+        let (w, h) = (opts.width, opts.height);
         let len = w as usize * h as usize;
         let (threads, rows) = (opts.threads.max(1), opts.strip_rows.max(1));
         let tile = (opts.tile_width, rows);
+        let kind = (opts.depth, opts.inv_w);
         let t1 = Instant::now();
         let mut color = vec![BACKGROUND; len];
-        let (depth, pixels_written) = draw(
-            &frame, &mut color, opts.depth, BACKGROUND, tile, threads, fragment,
-        )?;
+        let (depth, pixels_written) = draw(src, &mut color, kind, BACKGROUND, tile, threads)?;
         let raster_ms = t1.elapsed().as_secs_f64() * 1e3;
+        let stats = stats();
         let t2 = Instant::now();
         let ids = if opts.ids {
             let mut ids = vec![TriangleId(0); len];
-            draw(
-                &frame,
-                &mut ids,
-                opts.depth,
-                TriangleId(0),
-                tile,
-                threads,
-                fragment,
-            )?;
+            draw(src, &mut ids, kind, TriangleId(0), tile, threads)?;
             Some(ids.into_iter().map(|t| t.0).collect())
         } else {
             None
@@ -394,105 +438,160 @@ impl Job<'_> {
     }
 }
 
-/// Draws `frame` into `color` (every strip cleared to `clear` first) with
-/// a new depth buffer of `kind`; returns the depth image and the pixels
-/// written.
-fn draw<const S: u32, const N: usize, C, F>(
-    frame: &Frame<'_, S, N>,
+/// Draws one rectangle of the image into buffers that hold exactly it.
+trait DrawRect<C>: Sync {
+    /// The image's width.
+    fn width(&self) -> u32;
+
+    /// Draws `rect` into `color` and `depth`; returns the pixels written.
+    fn draw<D: DepthBuffer + ?Sized>(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<u64, Error>;
+}
+
+/// A frame set up once, drawn rectangle by rectangle.
+struct SetUp<'a, 'f, const S: u32, const N: usize, F> {
+    frame: &'a Frame<'f, S, N>,
+    fragment: &'a F,
+}
+
+impl<C: PixelFormat, const S: u32, const N: usize, F> DrawRect<C> for SetUp<'_, '_, S, N, F>
+where
+    F: FragmentShader<N> + Sync,
+{
+    fn width(&self) -> u32 {
+        self.frame.config().width
+    }
+
+    fn draw<D: DepthBuffer + ?Sized>(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<u64, Error> {
+        Ok(self
+            .frame
+            .render_rect_shaded(rect, color, depth, self.fragment)?
+            .pixels_written)
+    }
+}
+
+/// The clipless mode: the mesh submitted again to a strip renderer for
+/// each rectangle, from vertices processed once (counters summed over
+/// the rectangles of the colour image).
+struct Immediate<'a, const S: u32, const N: usize, A, F> {
+    config: Config,
+    mesh: &'a Mesh<'a, A>,
+    cache: &'a [ProcessedVertex],
+    fragment: &'a F,
+    stats: &'a std::sync::Mutex<Stats>,
+}
+
+impl<C: PixelFormat, const S: u32, const N: usize, A, F> DrawRect<C> for Immediate<'_, S, N, A, F>
+where
+    A: Attributes<N> + Sync,
+    F: FragmentShader<N> + Sync,
+{
+    fn width(&self) -> u32 {
+        self.config.width
+    }
+
+    fn draw<D: DepthBuffer + ?Sized>(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<u64, Error> {
+        let mut r = microraster::StripRenderer::<C, D, S, N, &F>::with_shader_rect(
+            self.config,
+            rect,
+            color,
+            depth,
+            self.fragment,
+        )?;
+        r.submit_processed_mesh(self.mesh, 0, self.cache)?;
+        if C::SHADED {
+            if let Ok(mut s) = self.stats.lock() {
+                *s += r.stats();
+            }
+        }
+        Ok(r.render_stats().pixels_written)
+    }
+}
+
+/// Draws `src` into `color` (every strip or tile cleared to `clear`
+/// first) with a new depth buffer of `kind`, cleared to the far plane, or
+/// with `reversed` (1/w depth) to 0; returns the depth image and the
+/// pixels written.
+fn draw<C, R>(
+    src: &R,
     color: &mut [C],
-    kind: DepthKind,
+    (kind, reversed): (DepthKind, bool),
     clear: C,
-    (tile_w, rows): (u32, u32),
+    tile: (u32, u32),
     threads: usize,
-    fragment: &F,
 ) -> Result<(DepthImage, u64), String>
 where
     C: PixelFormat + Send + Sync,
-    F: FragmentShader<N> + Sync,
+    R: DrawRect<C>,
 {
     let len = color.len();
+    macro_rules! with {
+        ($t:ty, $image:path) => {{
+            let z: $t = if reversed {
+                <$t as DepthWord>::NEAR
+            } else {
+                <$t as DepthWord>::FAR
+            };
+            let mut d = vec![z; len];
+            let px = draw_with(src, color, Some((&mut d[..], z)), clear, tile, threads)?;
+            ($image(d), px)
+        }};
+    }
     Ok(match kind {
-        DepthKind::U16 => {
-            let mut d = vec![u16::MAX; len];
-            let px = draw_with(
-                frame,
-                color,
-                Some(&mut d[..]),
-                clear,
-                (tile_w, rows),
-                threads,
-                fragment,
-            )?;
-            (DepthImage::U16(d), px)
-        }
-        DepthKind::U32 => {
-            let mut d = vec![u32::MAX; len];
-            let px = draw_with(
-                frame,
-                color,
-                Some(&mut d[..]),
-                clear,
-                (tile_w, rows),
-                threads,
-                fragment,
-            )?;
-            (DepthImage::U32(d), px)
-        }
-        DepthKind::F32 => {
-            let mut d = vec![microraster::DepthF32::FAR; len];
-            let px = draw_with(
-                frame,
-                color,
-                Some(&mut d[..]),
-                clear,
-                (tile_w, rows),
-                threads,
-                fragment,
-            )?;
-            (DepthImage::F32(d), px)
-        }
+        DepthKind::U16 => with!(u16, DepthImage::U16),
+        DepthKind::U32 => with!(u32, DepthImage::U32),
+        DepthKind::F32 => with!(microraster::DepthF32, DepthImage::F32),
         DepthKind::None => {
-            let px = draw_with::<S, N, C, F, u32>(
-                frame,
-                color,
-                None,
-                clear,
-                (tile_w, rows),
-                threads,
-                fragment,
-            )?;
+            let px = draw_with::<C, R, u32>(src, color, None, clear, tile, threads)?;
             (DepthImage::None, px)
         }
     })
 }
 
-/// [`draw`] into a depth buffer of `T` words (or none).
-fn draw_with<const S: u32, const N: usize, C, F, T>(
-    frame: &Frame<'_, S, N>,
+/// [`draw`] into a depth buffer of `T` words cleared to the given word
+/// (or none).
+fn draw_with<C, R, T>(
+    src: &R,
     color: &mut [C],
-    depth: Option<&mut [T]>,
+    depth: Option<(&mut [T], T)>,
     clear: C,
     (tile_w, rows): (u32, u32),
     threads: usize,
-    fragment: &F,
 ) -> Result<u64, String>
 where
     C: PixelFormat + Send + Sync,
-    F: FragmentShader<N> + Sync,
+    R: DrawRect<C>,
     T: DepthWord,
 {
-    let width = frame.config().width as usize;
     let tile = (tile_w as usize, rows as usize);
+    let (depth, z) = match depth {
+        Some((d, z)) => (Some(d), z),
+        None => (None, T::FAR),
+    };
+    let width = src.width() as usize;
     let draw_tile = |_, rect: [u32; 4], c: &mut [C], d: Option<&mut [T]>| -> Result<u64, Error> {
         c.fill(clear);
-        Ok(match d {
+        match d {
             Some(d) => {
-                d.fill(T::FAR);
-                frame.render_rect_shaded(rect, c, d, fragment)?
+                d.fill(z);
+                src.draw(rect, c, d)
             }
-            None => frame.render_rect_shaded(rect, c, &mut NoDepth, fragment)?,
+            None => src.draw(rect, c, &mut NoDepth),
         }
-        .pixels_written)
     };
     for_each_tile(color, depth, width, tile, threads, false, draw_tile).map_err(|e| e.to_string())
 }

@@ -107,7 +107,7 @@ fn output_is_identical_for_any_threads_and_strip_rows() {
 
 /// `--mode clipless`: the same image, ids and depth for any thread count
 /// and strip height, close to the clipping mode's (the quantizations
-/// differ by a hair at edges), and a typed error where it cannot apply.
+/// differ by a hair at edges), for the built-in scenes and a lit model.
 #[test]
 fn clipless_mode_renders_the_same_frame_for_any_split() {
     for scene in ["cubes", "sphere"] {
@@ -145,17 +145,28 @@ fn clipless_mode_renders_the_same_frame_for_any_split() {
         let px = |v: &Value| v["counters"]["pixels_written"].as_u64().unwrap() as f64;
         assert!((px(&clipless) / px(&clipping) - 1.0).abs() < 0.002);
     }
+    // A lit, textured model (Phong by default): strip renderers per strip
+    // or tile with the shader, the same outputs for any split, coverage
+    // within 0.2 % of the clipping mode's.
     let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
-    let e = fails(&[
-        "render",
-        "--obj",
-        spot,
-        "--mode",
-        "clipless",
-        "--out",
-        tmp("c.png").to_str().unwrap(),
-    ]);
-    assert!(e.contains("clipless"), "{e}");
+    let obj = |extra: &[&'static str]| {
+        let mut a = vec!["--obj", spot, "--size", "200x150", "--mode", "clipless"];
+        a.extend_from_slice(extra);
+        a
+    };
+    let one = outputs("clipless-spot-1", &obj(&["--threads", "1"]));
+    for (tag, extra) in [
+        ("2-7", &["--threads", "2", "--strip-rows", "7"][..]),
+        ("tile", &["--threads", "2", "--tile", "32x32"][..]),
+    ] {
+        let other = outputs(&format!("clipless-spot-{tag}"), &obj(extra));
+        assert!(one == other, "Spot clipless {tag} differs");
+    }
+    let (clipless, _) = stats(&obj(&[]));
+    let (clipping, _) = stats(&["--obj", spot, "--size", "200x150"]);
+    let px = |v: &Value| v["counters"]["pixels_written"].as_u64().unwrap() as f64;
+    assert!(px(&clipping) > 4000.0);
+    assert!((px(&clipless) / px(&clipping) - 1.0).abs() < 0.002);
     let strips = outputs("clipless-strips", &["--mode", "clipless", "--threads", "2"]);
     for tile in ["32x32", "7x5", "800x3"] {
         let tiles = outputs(
@@ -240,9 +251,46 @@ fn inv_w_depth_kind() {
         o,
     ]);
     assert!(e.contains("depth buffer"), "{e}");
+    // A lit model too (set up once, Phong and texture), into `u32` and
+    // `f32` buffers: the same coverage as window z, nearer larger, and the
+    // `f32` values the `u32` ones to 24 significant bits.
     let spot = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
-    let e = fails(&["render", "--depth-kind", "inv-w", "--obj", spot, "--out", o]);
-    assert!(e.contains("--obj"), "{e}");
+    let args = |kind: &'static str, depth: &'static str| {
+        vec![
+            "--obj",
+            spot,
+            "--size",
+            "160x120",
+            "--depth-kind",
+            kind,
+            "--depth",
+            depth,
+        ]
+    };
+    let inv = outputs("spot-invw", &args("inv-w", "u32"));
+    let inv_f = outputs("spot-invw-f32", &args("inv-w", "f32"));
+    let z = outputs("spot-z", &args("z", "u32"));
+    let u = |b: &[u8]| -> Vec<u32> {
+        b.chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    let f = |b: &[u8]| -> Vec<f32> {
+        b.chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    let (inv_d, inv_fd, z_d) = (u(&inv[2]), f(&inv_f[2]), u(&z[2]));
+    let drawn = inv_d.iter().filter(|&&v| v != 0).count();
+    assert!(drawn > 2000, "{drawn}");
+    assert_eq!(drawn, z_d.iter().filter(|&&v| v != u32::MAX).count());
+    for (&a, &b) in inv_d.iter().zip(&inv_fd) {
+        let b = b as f64 * 4_294_967_296.0;
+        assert!(
+            (a as f64 - b).abs() <= (a as f64 / 8_388_608.0).max(1.0),
+            "{a} {b}"
+        );
+    }
 }
 
 /// The colour, id and depth outputs of `render` with `extra` arguments.

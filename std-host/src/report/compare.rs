@@ -53,6 +53,10 @@ pub struct ErrorStats {
     pub coverage_diff: usize,
     /// Differing pixels that snapping and depth ties do not explain.
     pub unexplained: usize,
+    /// Depth-test flips: differing pixels that both triangles cover away
+    /// from their edges (beyond the tolerance), so the depth test, not
+    /// coverage, chose another surface than the exact depths do.
+    pub depth_flips: usize,
     /// A few unexplained pixels: `(x, y, core id + 1, reference id + 1)`.
     pub unexplained_examples: Vec<(u32, u32, u32, u32)>,
     /// Pixels compared for depth and colour (same triangle in both).
@@ -180,6 +184,13 @@ pub(crate) fn compare(
             t.as_ref()
                 .is_some_and(|(_, q)| q.inv_w > 0.0 && q.edge_distance.abs() <= tol.xy)
         };
+        let inside = |t: &Option<(&Prepared, reference::Sample)>| {
+            t.as_ref()
+                .is_some_and(|(_, q)| q.inside && q.inv_w > 0.0 && q.edge_distance > tol.xy)
+        };
+        if inside(&sa) && inside(&sb) {
+            s.depth_flips += 1;
+        }
         let explained = near_edge(&sa)
             || near_edge(&sb)
             || match (&sa, &sb) {

@@ -70,13 +70,13 @@ pub fn markdown(
         "| configuration | ★ M4F | ★ host | M4F render (instr.) | M4F rasterization | \
          M0 render | M0 rasterization | host frame time, sum (ms): median [min, max] | \
          pixels differing | coverage only | \
-         unexplained | depth max (LSB) | depth beyond bound | depth vs exact, mean | \
+         unexplained | depth flips | depth max (LSB) | depth beyond bound | depth vs exact, mean | \
          depth vs exact, max | colour max (LSB) | colour beyond bound | matrix error (rel.) | \
          vertex error (px) |"
     );
     let _ = writeln!(
         s,
-        "|---|:-:|:-:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
+        "|---|:-:|:-:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
     );
     let (by_count, by_time) = stars(summary);
     let star = |front: &[usize], i: usize| if front.contains(&i) { "★" } else { "" };
@@ -84,7 +84,7 @@ pub fn markdown(
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {:.2} [{:.2}, {:.2}] | {:.3} % | {:.3} % | {} | \
-             {:.0} | {} | {} | {} | {:.0} | {} | {} | {} |",
+             {} | {:.0} | {} | {} | {} | {:.0} | {} | {} | {} |",
             r.config.label(),
             star(&by_count, i),
             star(&by_time, i),
@@ -98,6 +98,7 @@ pub fn markdown(
             r.id_diff_pct,
             r.coverage_diff_pct,
             r.unexplained,
+            r.depth_flips,
             r.depth_max_lsb,
             r.depth_beyond,
             sci(r.depth_mean_abs),
@@ -148,19 +149,19 @@ pub fn markdown(
     let _ = writeln!(
         s,
         "| scene | configuration | time (ms): median [min, max] | covered | differing | coverage only | \
-         unexplained | depth max (LSB) | depth mean (LSB) | depth beyond | colour max | \
+         unexplained | depth flips | depth max (LSB) | depth mean (LSB) | depth beyond | colour max | \
          colour mean | colour beyond | matrix err | clip err (rel. w) | vertex err (px) | \
          vertex err (z) |"
     );
     let _ = writeln!(
         s,
-        "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
+        "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
     );
     for r in rows {
         let e = &r.errors;
         let _ = writeln!(
             s,
-            "| {} | {} | {:.3} [{:.3}, {:.3}] | {} | {} | {} | {} | {:.0} | {:.2} | {} | {:.0} | {:.3} | {} | \
+            "| {} | {} | {:.3} [{:.3}, {:.3}] | {} | {} | {} | {} | {} | {:.0} | {:.2} | {} | {:.0} | {:.3} | {} | \
              {} | {} | {} | {} |",
             r.scene,
             r.config.label(),
@@ -171,6 +172,7 @@ pub fn markdown(
             e.id_diff,
             e.coverage_diff,
             e.unexplained,
+            e.depth_flips,
             e.depth_max_lsb,
             e.depth_mean_lsb,
             e.depth_beyond,

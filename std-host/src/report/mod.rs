@@ -4,11 +4,15 @@
 //! Design note: the report sweeps the eight compile-time configurations of
 //! the core (subpixel bits 4 / 8, depth `u16` / `u32`, matrices built with
 //! `libm` / `micromath`), and on `S8 libm` the run-time choices of issue
-//! 12 ([`Variant`]: immediate mode, the clipless mode, 1/w depth, tiles of
-//! 16, 32 and 64 pixels; the 1/w configurations are measured against a
-//! reference drawn with the same projection and depth test), over four scenes (the four cubes, Spot, the teapot
-//! and the Stanford bunny from `assets/models/`), every one with per-vertex
-//! colours from its normals so that Gouraud interpolation is exercised.
+//! 12 ([`Variant`]: immediate mode, the clipless mode, 1/w depth in
+//! `u16`, `u32` and `f32`, tiles of 16, 32 and 64 pixels; the 1/w
+//! configurations are measured against a reference drawn with the same
+//! projection and depth test), over five scenes: the four cubes, Spot, the
+//! teapot and the Stanford bunny from `assets/models/`, every one with
+//! per-vertex colours from its normals so that Gouraud interpolation is
+//! exercised, and `layers` ([`layers_spec`]), pairs of parallel surfaces
+//! 10^-3, 10^-5 and 10^-7 of their distance apart at distances 0.5 to 32,
+//! where the depth buffer's resolution shows as depth-test flips.
 //!
 //! For each configuration and scene it measures
 //! - the frame time: median of repeated single-threaded frames, each one
@@ -282,6 +286,8 @@ pub struct Summary {
     pub coverage_diff_pct: f64,
     /// Unexplained differences (all scenes).
     pub unexplained: usize,
+    /// Depth-test flips (all scenes; see [`ErrorStats::depth_flips`]).
+    pub depth_flips: usize,
     /// Largest depth error, LSB.
     pub depth_max_lsb: f64,
     /// Mean `|stored / 2^bits - exact|` depth, window-depth units.
@@ -322,6 +328,7 @@ pub fn summarize(rows: &[Row], device: &[firmware::FirmwareRow]) -> Vec<Summary>
             id_diff_pct: 100.0 * sum(&|r| r.errors.id_diff) as f64 / covered as f64,
             coverage_diff_pct: 100.0 * sum(&|r| r.errors.coverage_diff) as f64 / covered as f64,
             unexplained: sum(&|r| r.errors.unexplained),
+            depth_flips: sum(&|r| r.errors.depth_flips),
             depth_max_lsb: fmax(&|r| r.errors.depth_max_lsb),
             depth_mean_abs: rs
                 .iter()
@@ -402,6 +409,7 @@ fn default_models_dir() -> PathBuf {
 pub fn load_scene(name: &str, models: &Path, aspect: f32) -> Result<SceneSpec, String> {
     let file = match name {
         "cubes" => return Ok(cubes_spec()),
+        "layers" => return Ok(layers_spec(aspect)),
         "spot" => "spot.obj",
         "teapot" => "teapot.obj",
         "bunny" => "stanford-bunny.obj",
@@ -708,6 +716,41 @@ mod tests {
                 assert!(e.id_diff * 50 < e.covered, "{config:?} {e:?}");
             }
         }
+    }
+
+    /// The close surfaces of `layers`: a `u16` buffer flips many pixels
+    /// (window z and 1/w alike), `u32` none at 800x600 (at 400x300 the
+    /// snapping's depth error, twice as large a share of a pixel's depth
+    /// change, flips thousands in the narrowest gaps), and every difference
+    /// is explained (a tie within what snapping and the buffer allow).
+    #[test]
+    fn layers_count_depth_flips() {
+        let (w, h) = (800, 600);
+        let scene = SceneRefs::new(layers_spec(w as f32 / h as f32), w, h);
+        let objects: Vec<CoreObject> = scene.spec.objects.iter().map(CoreObject::new).collect();
+        let flips = |c: Configuration| {
+            let input = CoreInput {
+                spec: scene.spec(&c),
+                objects: &objects,
+                math: c.math,
+                width: w,
+                height: h,
+            };
+            let run = runner(input, c).unwrap().finish().unwrap();
+            let (e, _) = scene.errors(&c, &run, w, h);
+            assert_eq!(e.unexplained, 0, "{c:?} {e:?}");
+            assert!(e.covered > 5000, "{e:?}");
+            e.depth_flips
+        };
+        let (z16, z32) = (config(8, 16, Variant::Base), config(8, 32, Variant::Base));
+        let (inv16, inv32) = (config(8, 16, Variant::InvW), config(8, 32, Variant::InvW));
+        let (a, b, c, d) = (flips(z16), flips(inv16), flips(z32), flips(inv32));
+        assert!(a > 1000 && b > 1000, "{a} {b}");
+        assert_eq!((c, d), (0, 0), "{a} {b}");
+        println!("layers at {w}x{h}: flips u16 {a} / {b}, u32 {c} / {d} (z / 1/w)");
+        // Both depth kinds are affine in 1/w: the same resolution in an
+        // integer buffer, so about the same flips.
+        assert!(a.abs_diff(b) * 20 < a, "{a} {b}");
     }
 
     #[test]

@@ -168,6 +168,69 @@ pub fn mesh_spec(name: &str, mesh: &obj::LoadedMesh, aspect: f32) -> SceneSpec {
     }
 }
 
+/// Distances of the `layers` scene's pairs (near plane 0.1, far 100).
+pub const LAYER_DISTANCES: [f32; 4] = [0.5, 2.0, 8.0, 32.0];
+/// Gaps of the `layers` scene's pairs, relative to their distance.
+pub const LAYER_GAPS: [f32; 3] = [1e-3, 1e-5, 1e-7];
+
+/// Close surfaces, for depth-test flips: for each distance of
+/// [`LAYER_DISTANCES`] and gap of [`LAYER_GAPS`], a pair of parallel
+/// squares (turned 30° about the vertical, so depth varies across them)
+/// seen from the origin down -z (60° field of view, near 0.1, far 100),
+/// each pair in a cell of a 4x3 grid on screen (a row per gap). The farther square lies
+/// the gap behind the nearer one (its centre scaled from the eye by `1 +
+/// gap`), is 10 % larger and is drawn first, so wherever both cover a
+/// pixel the nearer must win, and a buffer that cannot tell them apart
+/// (a tie, under `Less` or `Greater`) keeps the farther: a flip.
+pub fn layers_spec(aspect: f32) -> SceneSpec {
+    let (fov, near, far) = (60.0f32, 0.1f32, 100.0f32);
+    let t = (fov.to_radians() * 0.5).tan();
+    let (c, sn) = (30f32.to_radians().cos(), 30f32.to_radians().sin());
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    let mut colors = Vec::new();
+    for (j, &gap) in LAYER_GAPS.iter().enumerate() {
+        for (i, &d) in LAYER_DISTANCES.iter().enumerate() {
+            // The cell's centre in NDC, then on the ray at distance d.
+            let (nx, ny) = (-0.75 + 0.5 * i as f32, (1.0 - j as f32) * 2.0 / 3.0);
+            let centre = [nx * t * aspect * d, ny * t * d, -d];
+            for (scale, half, color) in [
+                (1.0 + gap, 0.22f32, Rgb888::new(40, 60, 200)),
+                (1.0, 0.2f32, Rgb888::new(230, 200, 40)),
+            ] {
+                let o = centre.map(|v| v * scale);
+                let (hx, hy) = (half * t * aspect * d * scale, half * t * d * scale);
+                let base = positions.len() as u32;
+                for (u, v) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    // u along (cos 30°, 0, sin 30°), v up.
+                    positions.push([o[0] + u * hx * c, o[1] + v * hy, o[2] + u * hx * sn]);
+                    colors.push(color);
+                }
+                indices.push([base, base + 1, base + 2]);
+                indices.push([base, base + 2, base + 3]);
+            }
+        }
+    }
+    SceneSpec {
+        name: "layers".into(),
+        objects: vec![SpecObject {
+            positions,
+            indices,
+            colors,
+            model: Vec::new(),
+        }],
+        camera: Camera {
+            eye: [0.0, 0.0, 0.0],
+            target: [0.0, 0.0, -1.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: fov,
+            near,
+            far,
+            inv_w: false,
+        },
+    }
+}
+
 pub(crate) fn op_matrix<F: FloatFns>(op: cubes::Op) -> Mat4 {
     match op {
         cubes::Op::Translate(t) => Mat4::translation(Vec3::from_array(t)),
