@@ -60,8 +60,10 @@ pub fn markdown(
          slowest); errors against the `f64` reference renderer (`std-host/src/reference.rs`). \
          Speed of record: the firmware's instructions for the four cubes at 320x240 in the same \
          configuration on the Cortex-M4F and the Cortex-M0 under QEMU (`docs/embedded.md`, \
-         *Configurations*, measured by `.ci/firmware.sh`). Written by \
-         `microraster report speed-vs-error`.\n",
+         *Configurations*, measured by `.ci/firmware.sh`). *Pixels differing* pools every scene \
+         but `layers` (close parallel surfaces), which counts in *depth flips* only: pixels both \
+         triangles cover away from their edges where the depth test chose the other one. \
+         Written by `microraster report speed-vs-error`.\n",
         info.width, info.height, info.reps
     );
     let _ = writeln!(s, "## By configuration (all scenes together)\n");

@@ -280,7 +280,8 @@ pub struct Summary {
     /// cubes at 320x240, from `docs/embedded.md`).
     pub device: firmware::DeviceCounts,
     /// Pixels whose triangle differs, percent of the reference's covered
-    /// pixels (all scenes together).
+    /// pixels (all scenes together but [`LAYERS`], which counts in
+    /// `depth_flips` only).
     pub id_diff_pct: f64,
     /// Coverage-only differences, percent of covered pixels.
     pub coverage_diff_pct: f64,
@@ -315,7 +316,19 @@ pub fn summarize(rows: &[Row], device: &[firmware::FirmwareRow]) -> Vec<Summary>
         if rs.is_empty() {
             continue;
         }
-        let covered: usize = rs.iter().map(|r| r.errors.covered).sum::<usize>().max(1);
+        // Pixels differing pool the scenes that measure coverage; the
+        // close surfaces of `layers` count in depth flips only (their
+        // ties would swamp every edge pixel).
+        let pooled: Vec<&Row> = match rs.iter().any(|r| r.scene != LAYERS) {
+            true => rs.iter().copied().filter(|r| r.scene != LAYERS).collect(),
+            false => rs.clone(),
+        };
+        let covered: usize = pooled
+            .iter()
+            .map(|r| r.errors.covered)
+            .sum::<usize>()
+            .max(1);
+        let pooled_sum = |f: &dyn Fn(&Row) -> usize| pooled.iter().map(|r| f(r)).sum::<usize>();
         let same: usize = rs.iter().map(|r| r.errors.same).sum::<usize>().max(1);
         let fmax = |f: &dyn Fn(&Row) -> f64| rs.iter().map(|r| f(r)).fold(0.0, f64::max);
         let sum = |f: &dyn Fn(&Row) -> usize| rs.iter().map(|r| f(r)).sum::<usize>();
@@ -325,8 +338,9 @@ pub fn summarize(rows: &[Row], device: &[firmware::FirmwareRow]) -> Vec<Summary>
             time_min_ms: rs.iter().map(|r| r.time_min_ms).sum(),
             time_max_ms: rs.iter().map(|r| r.time_max_ms).sum(),
             device: firmware::counts(device, &c),
-            id_diff_pct: 100.0 * sum(&|r| r.errors.id_diff) as f64 / covered as f64,
-            coverage_diff_pct: 100.0 * sum(&|r| r.errors.coverage_diff) as f64 / covered as f64,
+            id_diff_pct: 100.0 * pooled_sum(&|r| r.errors.id_diff) as f64 / covered as f64,
+            coverage_diff_pct: 100.0 * pooled_sum(&|r| r.errors.coverage_diff) as f64
+                / covered as f64,
             unexplained: sum(&|r| r.errors.unexplained),
             depth_flips: sum(&|r| r.errors.depth_flips),
             depth_max_lsb: fmax(&|r| r.errors.depth_max_lsb),

@@ -168,6 +168,9 @@ pub fn mesh_spec(name: &str, mesh: &obj::LoadedMesh, aspect: f32) -> SceneSpec {
     }
 }
 
+/// The name of the close-surfaces scene ([`layers_spec`]).
+pub const LAYERS: &str = "layers";
+
 /// Distances of the `layers` scene's pairs (near plane 0.1, far 100).
 pub const LAYER_DISTANCES: [f32; 4] = [0.5, 2.0, 8.0, 32.0];
 /// Gaps of the `layers` scene's pairs, relative to their distance.
@@ -212,7 +215,7 @@ pub fn layers_spec(aspect: f32) -> SceneSpec {
         }
     }
     SceneSpec {
-        name: "layers".into(),
+        name: LAYERS.into(),
         objects: vec![SpecObject {
             positions,
             indices,
