@@ -480,40 +480,20 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             }
             .into());
         }
-        if let Some(actual) = self.depth.held() {
-            if actual < tile {
-                return Err(Error::DepthBufferSize {
-                    expected: tile,
-                    actual,
-                }
-                .into());
-            }
-        }
+        self.check_depth_holds(tile)?;
+        let origin = self.origin;
         let mut total = RenderStats::default();
         for t in 0..bins.tiles() {
             let [x0, x1, y0, y1] = bins.rect(t);
             let len = (x1 - x0) as usize * (y1 - y0) as usize;
-            let color_len = self.color.len();
-            let Some((color, depth)) = self.color.get_mut(..len).and_then(|color| {
-                let depth = self
-                    .depth
-                    .cleared_with(len, self.clear_z32, color, self.background)?;
-                Some((color, depth))
-            }) else {
-                // Unreachable: both were checked to hold a whole tile.
-                return Err(Error::ColorBufferSize {
-                    expected: len,
-                    actual: color_len,
-                }
-                .into());
-            };
+            let (color, depth) = self.cleared(len)?;
             let stats = frame.render_tile(bins, t, color, depth)?;
             total.pixels_written += stats.pixels_written;
             // Tile corners are below 2^14; saturating keeps an absurd
             // origin from overflowing.
             let top = Point::new(
-                self.origin.x.saturating_add(x0 as i32),
-                self.origin.y.saturating_add(y0 as i32),
+                origin.x.saturating_add(x0 as i32),
+                origin.y.saturating_add(y0 as i32),
             );
             let area = Rectangle::new(top, Size::new(x1 - x0, y1 - y0));
             target.push_strip(&area, color).map_err(DrawError::Target)?;
@@ -536,6 +516,37 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
             frame.render_rows_shaded(y0, y1, color, depth, fragment)
         })
+    }
+
+    /// [`Error::DepthBufferSize`] unless the depth buffer (if any) holds
+    /// `n` values.
+    fn check_depth_holds(&self, n: usize) -> Result<(), Error> {
+        match self.depth.held() {
+            Some(actual) if actual < n => Err(Error::DepthBufferSize {
+                expected: n,
+                actual,
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// The first `len` values of both buffers, cleared (in one pass where
+    /// the depth buffer is a slice); an error if either holds fewer (the
+    /// callers check both first, so that is unreachable).
+    fn cleared(&mut self, len: usize) -> Result<(&mut [P], &mut D::Rows), Error> {
+        let color_len = self.color.len();
+        let (clear_z32, background) = (self.clear_z32, self.background);
+        let depth = &mut self.depth;
+        self.color
+            .get_mut(..len)
+            .and_then(|color| {
+                let depth = depth.cleared_with(len, clear_z32, color, background)?;
+                Some((color, depth))
+            })
+            .ok_or(Error::ColorBufferSize {
+                expected: len,
+                actual: color_len,
+            })
     }
 
     /// The strip loop shared by both modes: check, then per strip clear,
@@ -561,39 +572,18 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             }
             .into());
         }
-        if let Some(actual) = self.depth.held() {
-            if actual < full {
-                return Err(Error::DepthBufferSize {
-                    expected: full,
-                    actual,
-                }
-                .into());
-            }
-        }
+        self.check_depth_holds(full)?;
+        let origin = self.origin;
         let mut total = RenderStats::default();
         let mut y0 = 0;
         while y0 < height {
             let y1 = y0.saturating_add(rows).min(height);
             let len = width as usize * (y1 - y0) as usize;
-            let color_len = self.color.len();
-            // Both cleared (in one pass where the depth strip is a slice).
-            let Some((color, depth)) = self.color.get_mut(..len).and_then(|color| {
-                let depth = self
-                    .depth
-                    .cleared_with(len, self.clear_z32, color, self.background)?;
-                Some((color, depth))
-            }) else {
-                // Unreachable: both were checked to hold `full >= len`.
-                return Err(Error::ColorBufferSize {
-                    expected: len,
-                    actual: color_len,
-                }
-                .into());
-            };
+            let (color, depth) = self.cleared(len)?;
             let stats = render(y0, y1, color, depth)?;
             total.pixels_written += stats.pixels_written;
             // y0 < 2^14; saturating keeps an absurd origin from overflowing.
-            let top = Point::new(self.origin.x, self.origin.y.saturating_add(y0 as i32));
+            let top = Point::new(origin.x, origin.y.saturating_add(y0 as i32));
             let area = Rectangle::new(top, Size::new(width, y1 - y0));
             target.push_strip(&area, color).map_err(DrawError::Target)?;
             y0 = y1;
