@@ -757,7 +757,13 @@ mod tests {
         let mut storage = [SetupTriangle::EMPTY; 16];
         let mut frame: Frame = Frame::new(config(), &mut storage).unwrap();
         scene(|p, c, id| frame.submit_clip_triangle(p, c, id).unwrap());
-        for (tw, th) in [(8, 8), (16, 16), (5, 7), (48, 3), (64, 64), (1, 40)] {
+        let sizes: &[(u32, u32)] = if cfg!(miri) {
+            // Miri is slow: two sizes (ragged, and wider than the frame).
+            &[(16, 16), (64, 64)]
+        } else {
+            &[(8, 8), (16, 16), (5, 7), (48, 3), (64, 64), (1, 40)]
+        };
+        for &(tw, th) in sizes {
             let mut offsets = vec![0u32; frame.tiles(tw, th) + 1];
             let mut items = vec![0u32; frame.tile_bin_entries(tw, th)];
             let bins = frame.bin_tiles(tw, th, &mut offsets, &mut items).unwrap();
