@@ -15,7 +15,10 @@
 //! `u32` ([`DepthWord::key`]). Its precision is relative, `2^-24` of the
 //! value down to `2^-24`, where a `u32` buffer keeps `2^-32` absolute: less
 //! near 1, far more near 0, which is where a reversed 1/w depth
-//! (`Mat4::perspective_inv_w`) puts distant surfaces.
+//! (`Mat4::perspective_inv_w`) puts distant surfaces. That is its storage
+//! only: the vertex depths it interpolates are `Z32`, made from an `f32`
+//! window depth rounded to `2^-25` absolute, so measured against the exact
+//! depth it is no more accurate than `u32` (`docs/accuracy.md`).
 
 /// The depth comparison: a fragment passes when `func(new, stored)` holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
