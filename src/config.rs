@@ -193,6 +193,9 @@ pub enum Error {
     /// Cluster data ([`ClusterSet`](crate::cull::ClusterSet)) that does
     /// not fit the mesh or whose tree does not tile its clusters.
     InvalidClusters(crate::cull::ClusterFault),
+    /// Normal classes ([`NormalClasses`](crate::normal_mask::NormalClasses))
+    /// that do not fit the mesh.
+    InvalidNormalClasses(crate::normal_mask::ClassFault),
     /// [`RasterMode::Clipless`] given to a [`Frame`](crate::Frame), whose
     /// setup storage holds snapped triangles only (draw clipless triangles
     /// with a [`StripRenderer`](crate::StripRenderer)), or to any receiver
@@ -268,6 +271,20 @@ impl core::fmt::Display for Error {
                 ),
                 crate::cull::ClusterFault::Node(i) => {
                     write!(f, "cluster node {i} does not tile its clusters")
+                }
+            },
+            Error::InvalidNormalClasses(fault) => match fault {
+                crate::normal_mask::ClassFault::Partitions => {
+                    write!(f, "normal classes need 1 to 16 partitions a side")
+                }
+                crate::normal_mask::ClassFault::Triangles => {
+                    write!(f, "normal classes need one class per triangle")
+                }
+                crate::normal_mask::ClassFault::Sizes => {
+                    write!(f, "normal classes need one size entry per class")
+                }
+                crate::normal_mask::ClassFault::Class(i) => {
+                    write!(f, "triangle {i} has a normal class beyond the classes")
                 }
             },
             Error::ModeUnsupported => write!(

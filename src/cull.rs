@@ -653,10 +653,10 @@ pub struct Eye {
     /// `E_xyz / E_w`, the eye as a point, when finite.
     pub point: Option<[f32; 3]>,
     /// The scale of `E`: the cofactors are `big` times the stored values.
-    big: f32,
+    pub(crate) big: f32,
     /// The frame, for the size guard ([`Eye::for_frame`]); `None` for a
     /// geometric eye ([`Eye::from_mvp`], [`Eye::at`]).
-    screen: Option<Screen>,
+    pub(crate) screen: Option<Screen>,
 }
 
 /// The rows `x`, `y`, `w` of a model-view-projection matrix as linear
@@ -673,7 +673,7 @@ struct Projection {
 /// What the size guard needs of a frame: the projection, the clip planes
 /// as linear forms (with `|l_xyz|`) and the snapping step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Screen {
+pub(crate) struct Screen {
     view: Projection,
     /// Near, far and the four guard-band planes.
     planes: [([f32; 4], f32); 6],
@@ -886,11 +886,24 @@ impl Screen {
         phi: f32,
         big: f32,
     ) -> bool {
-        let [q, a_min] = size;
+        self.winding_floor(origin, radius, big)
+            .is_some_and(|f| f.keeps(size, phi))
+    }
+
+    /// What [`Screen::keeps_winding`] asks of the ball of `radius` around
+    /// `origin`, found once for many facing values and sizes; `None` where
+    /// it holds for none (the ball is not inside near, far and the guard
+    /// band, or not wholly in front of the eye).
+    pub(crate) fn winding_floor(
+        &self,
+        origin: [f32; 3],
+        radius: f32,
+        big: f32,
+    ) -> Option<WindingFloor> {
         if !self.contains(origin, radius) {
-            return false;
+            return None;
         }
-        let Some(Reach {
+        let Reach {
             w_min,
             w_max,
             gx,
@@ -898,22 +911,52 @@ impl Screen {
             m,
             c1,
             ..
-        }) = self.view.reach(origin, radius)
-        else {
-            return false;
-        };
+        } = self.view.reach(origin, radius)?;
         let [hw, hh] = self.view.half;
         let [(rx, _), (ry, _), (rw, _)] = &self.view.rows;
         let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
-        let x = phi * big * hw * hh / (w_max * w_max * w_max);
         // Rounding: the transform (3 roundings a row, 2^-22 relative to
         // |row|_1 |(p, 1)|_inf, through the division by w) and NDC to
         // pixels (a few ulps of the pixel coordinate).
         let transform = (hw * (l1(rx) + gx * l1(rw)) + hh * (l1(ry) + gy * l1(rw))) * c1 / w_min;
         let pixels = hw * (1.0 + gx) + hh * (1.0 + gy);
         let rho = self.snap + (transform + pixels) / 1_048_576.0;
-        x * q > 4.0 * core::f32::consts::SQRT_2 * rho * m * (1.0 + MARGIN)
-            && x * a_min > 16.0 * rho * rho
+        Some(WindingFloor {
+            big,
+            half: [hw, hh],
+            w3: w_max * w_max * w_max,
+            w_min,
+            need: [
+                4.0 * core::f32::consts::SQRT_2 * rho * m * (1.0 + MARGIN),
+                16.0 * rho * rho,
+            ],
+        })
+    }
+}
+
+/// [`Screen::winding_floor`]: the size guard of one ball, for any facing
+/// value and triangle sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct WindingFloor {
+    big: f32,
+    half: [f32; 2],
+    /// `w_max^3` over the ball.
+    w3: f32,
+    /// The least `w` over the ball (positive).
+    pub(crate) w_min: f32,
+    /// What `X q` and `X a_min` must exceed.
+    need: [f32; 2],
+}
+
+impl WindingFloor {
+    /// Whether triangles of the ball with sizes `size` (as
+    /// [`ClusterNode::size`]) and facing values at least `phi` keep their
+    /// winding when snapped (see [`Screen::keeps_winding`]).
+    pub(crate) fn keeps(&self, size: [f32; 2], phi: f32) -> bool {
+        let [q, a_min] = size;
+        let [hw, hh] = self.half;
+        let x = phi * self.big * hw * hh / self.w3;
+        x * q > self.need[0] && x * a_min > self.need[1]
     }
 }
 

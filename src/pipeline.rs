@@ -22,6 +22,7 @@ use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Detail, Eye, Visit
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
+use crate::normal_mask::{BackMask, NormalClasses};
 use crate::setup::{inv_w3, setup, setup_geometry, triangulate, Rejected, SetupTriangle};
 use crate::shade::{Attributes, Varyings};
 use crate::stats::Stats;
@@ -297,19 +298,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
                     }
                 }
             });
-            let stale = |v: &ProcessedVertex| v.code & NONFINITE != 0;
-            let mut i = 0;
-            while let Some(start) = cache.get(i..).and_then(|c| c.iter().position(stale)) {
-                let a = i + start;
-                let run = cache
-                    .get(a..)
-                    .map_or(0, |c| c.iter().take_while(|v| stale(v)).count());
-                let b = a + run;
-                if let (Some(p), Some(out)) = (mesh.positions.get(a..b), cache.get_mut(a..b)) {
-                    self.process_vertices(mvp, p, out);
-                }
-                i = b;
-            }
+            process_stale(self, mvp, mesh.positions, cache);
         }
         let job = ClusterJob {
             inner: ProcessedJob {
@@ -321,6 +310,68 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             eye,
             detail,
             cull,
+        };
+        run_job::<S, N, _, _>(self.parts(), &job)
+    }
+
+    /// Like [`Submit::submit_mesh_cached`], with the lecture's normal
+    /// masks (see [`crate::normal_mask`]): a triangle whose normal class
+    /// is in this frame's [`BackMask`] (of the receiver's strip, for a
+    /// strip renderer) is counted in [`Stats::culled_mask`] without being
+    /// looked at further, and only the vertices of the others are
+    /// processed. For class data that fits the triangles the frame is the
+    /// one `submit_mesh_cached` draws (the mask's margin and size guard
+    /// skip only triangles it culls by winding, or that show nothing in
+    /// the sector); data that does not fit the mesh is refused with
+    /// [`Error::InvalidNormalClasses`] before anything is done. Nothing is
+    /// masked under [`CullMode::None`](crate::CullMode) or in the
+    /// clipless mode.
+    fn submit_masked<A: Attributes<N>>(
+        &mut self,
+        mesh: &Mesh<'_, A>,
+        mvp: &Mat4,
+        classes: &NormalClasses<'_>,
+        first_id: u32,
+        cache: &mut [ProcessedVertex],
+    ) -> Result<(), Error> {
+        let n = check_mesh_len(mesh.indices.len())?;
+        let cache = sized_cache(cache, mesh.positions.len())?;
+        classes.validate(mesh.indices.len())?;
+        if culled_object(&mut self.parts(), mesh, mvp, n) {
+            return Ok(());
+        }
+        let stage = self.stage();
+        let mask = match stage.config.mode {
+            RasterMode::Clipping => {
+                BackMask::for_frame::<S>(mvp, &stage.config, stage.slab, classes)
+            }
+            RasterMode::Clipless => BackMask::EMPTY,
+        };
+        if mask.is_empty() {
+            self.process_vertices(mvp, mesh.positions, cache);
+            return self.submit_processed_mesh(mesh, first_id, cache);
+        }
+        // The kept triangles' vertices marked stale, then processed in
+        // runs (as `submit_clusters` does with a vertex list): no other
+        // entry is read.
+        for (idx, &c) in mesh.indices.iter().zip(classes.classes) {
+            if !mask.contains(c) {
+                for &k in idx {
+                    if let Some(out) = cache.get_mut(k as usize) {
+                        *out = ProcessedVertex::STALE;
+                    }
+                }
+            }
+        }
+        process_stale(self, mvp, mesh.positions, cache);
+        let job = MaskJob {
+            inner: ProcessedJob {
+                mesh,
+                first_id,
+                cache,
+            },
+            classes: classes.classes,
+            mask,
         };
         run_job::<S, N, _, _>(self.parts(), &job)
     }
@@ -624,6 +675,31 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ProcessedJob<'_, A> {
 }
 
 impl<A> ProcessedJob<'_, A> {
+    /// A bound on the pieces of the triangle runs `runs` hands to its
+    /// argument: the mesh's triangle count where no cache entry needs
+    /// clipping (one sequential pass, `runs` not called), else one piece
+    /// or seven per triangle of the runs.
+    fn bound_over(&self, runs: impl FnOnce(&mut dyn FnMut(core::ops::Range<usize>))) -> usize {
+        let cache = self.cache;
+        if !cache.iter().any(|v| v.code & outcode::CLIP != 0) {
+            return self.mesh.indices.len();
+        }
+        let code = |k: u32| cache.get(k as usize).map_or(0, |v| v.code);
+        let mut n = 0usize;
+        runs(&mut |tris| {
+            for idx in self.mesh.indices.get(tris).unwrap_or(&[]) {
+                let or = code(idx[0]) | code(idx[1]) | code(idx[2]);
+                let k = if or & outcode::CLIP != 0 {
+                    MAX_PIECES
+                } else {
+                    1
+                };
+                n = n.saturating_add(k);
+            }
+        });
+        n
+    }
+
     /// Runs triangles `tris` (ids and attributes as in the whole mesh),
     /// which may use only the cache entries `verts`: an index outside
     /// them is counted as a bad index.
@@ -791,29 +867,10 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
     /// sequential pass), else one piece or seven per triangle of the
     /// clusters drawn.
     fn bound(&self, _: &Stage) -> usize {
-        let cache = self.inner.cache;
-        if !cache.iter().any(|v| v.code & outcode::CLIP != 0) {
-            // At most one piece a triangle, drawn or not: no walk of the
-            // tree (its tests are the costly part).
-            return self.inner.mesh.indices.len();
-        }
-        let code = |k: u32| cache.get(k as usize).map_or(0, |v| v.code);
-        let mut n = 0usize;
-        self.visit(
-            |tris, _| {
-                for idx in self.inner.mesh.indices.get(tris).unwrap_or(&[]) {
-                    let or = code(idx[0]) | code(idx[1]) | code(idx[2]);
-                    let k = if or & outcode::CLIP != 0 {
-                        MAX_PIECES
-                    } else {
-                        1
-                    };
-                    n = n.saturating_add(k);
-                }
-            },
-            |_, _| {},
-        );
-        n
+        // Where nothing needs clipping, no walk of the tree (its tests are
+        // the costly part).
+        self.inner
+            .bound_over(|f| self.visit(|tris, _| f(tris), |_, _| {}))
     }
 
     fn run<const S: u32, K: Sink<N> + ?Sized>(
@@ -838,6 +895,90 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
             },
         );
         *stats += skipped;
+    }
+}
+
+/// Processes every stale entry of `cache` (marked now, or a non-finite
+/// vertex of an earlier frame: processing it again gives the same entry),
+/// in runs, by one pass.
+fn process_stale<const S: u32, const N: usize, T: Submit<S, N> + ?Sized>(
+    receiver: &T,
+    mvp: &Mat4,
+    positions: &[Vec3],
+    cache: &mut [ProcessedVertex],
+) {
+    let stale = |v: &ProcessedVertex| v.code & NONFINITE != 0;
+    let mut i = 0;
+    while let Some(start) = cache.get(i..).and_then(|c| c.iter().position(stale)) {
+        let a = i + start;
+        let run = cache
+            .get(a..)
+            .map_or(0, |c| c.iter().take_while(|v| stale(v)).count());
+        let b = a + run;
+        if let (Some(p), Some(out)) = (positions.get(a..b), cache.get_mut(a..b)) {
+            receiver.process_vertices(mvp, p, out);
+        }
+        i = b;
+    }
+}
+
+struct MaskJob<'m, A> {
+    inner: ProcessedJob<'m, A>,
+    classes: &'m [u16],
+    mask: BackMask,
+}
+
+impl<A> MaskJob<'_, A> {
+    /// Calls `f(triangles)` for every run of kept triangles, in order, and
+    /// returns the count of masked ones.
+    fn visit(&self, mut f: impl FnMut(core::ops::Range<usize>)) -> u64 {
+        let n = self.classes.len();
+        let (mut i, mut masked) = (0usize, 0u64);
+        while i < n {
+            let rest = self.classes.get(i..).unwrap_or(&[]);
+            let skip = rest.iter().take_while(|&&c| self.mask.contains(c)).count();
+            masked += skip as u64;
+            i += skip;
+            let rest = self.classes.get(i..).unwrap_or(&[]);
+            let keep = rest.iter().take_while(|&&c| !self.mask.contains(c)).count();
+            if keep > 0 {
+                f(i..i + keep);
+            }
+            i += keep;
+        }
+        masked
+    }
+}
+
+impl<const N: usize, A: Attributes<N>> Job<N> for MaskJob<'_, A> {
+    fn max_pieces(&self) -> usize {
+        self.inner.max_pieces()
+    }
+
+    /// The mesh's triangle count where no cache entry needs clipping, else
+    /// one piece or seven per kept triangle.
+    fn bound(&self, _: &Stage) -> usize {
+        self.inner.bound_over(|f| {
+            self.visit(f);
+        })
+    }
+
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
+        let verts = 0..self.inner.cache.len();
+        let masked = self.visit(|tris| {
+            self.inner
+                .run_range::<S, N, K>(stage, stats, sink, tris, verts.clone())
+        });
+        *stats += Stats {
+            submitted: masked,
+            culled_mask: masked,
+            ..Stats::default()
+        };
     }
 }
 

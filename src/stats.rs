@@ -53,6 +53,9 @@ pub struct Stats {
     /// default): an object, or a cluster-tree node, whose projected bound
     /// is below [`Config::detail`](crate::Config::detail) pixels across.
     pub culled_detail: u64,
+    /// Skipped before transform because its normal's class is in the
+    /// frame's back mask ([`Submit::submit_masked`](crate::Submit::submit_masked)).
+    pub culled_mask: u64,
 }
 
 impl Stats {
@@ -70,6 +73,7 @@ impl Stats {
             self.culled_cluster,
             self.culled_hierarchy,
             self.culled_detail,
+            self.culled_mask,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
@@ -91,6 +95,7 @@ impl Stats {
             culled_cluster: self.culled_cluster.saturating_add(o.culled_cluster),
             culled_hierarchy: self.culled_hierarchy.saturating_add(o.culled_hierarchy),
             culled_detail: self.culled_detail.saturating_add(o.culled_detail),
+            culled_mask: self.culled_mask.saturating_add(o.culled_mask),
         }
     }
 }

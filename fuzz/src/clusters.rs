@@ -12,14 +12,24 @@
 //! never drops such a node, included); and an honest set stores no piece
 //! that `submit_mesh_cached` does not, in its order (detail culling drops
 //! whole clusters, so that holds with it too).
+//!
+//! Normal masks on the same mesh, matrix and settings: classes built
+//! honestly (each triangle's class, per class its sizes and sphere) or
+//! arbitrary (any partitions, class ids, lengths, NaN and huge sizes and
+//! spheres). `validate` refuses exactly what `submit_masked` refuses,
+//! with nothing counted or stored; the counters add up; under
+//! `CullMode::None` the pieces are the reference's; honest classes store
+//! a subsequence of the reference's pieces, in order.
 
 use crate::{check_accounting, MatIn, F};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 use microraster::cull::{ClusterFault, CullVolume, NormalCone};
+use microraster::normal_mask::{class_count, classify, NO_CLASS};
 use microraster::prelude::Submit;
+use microraster::NormalClasses;
 use microraster::{
-    BoundingSphere, Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Config, CullMode, Error, Frame,
-    FrontFace, Mesh, MeshColors, ProcessedVertex, SetupTriangle, Vec3,
+    BoundingSphere, Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Config, CullMode,
+    Error, Frame, FrontFace, Mesh, MeshColors, ProcessedVertex, SetupTriangle, Vec3,
 };
 
 /// Raw node data.
@@ -54,6 +64,12 @@ pub struct ClusterInput {
     /// Detail culling's threshold in pixels (0: off).
     detail: u8,
     storage: u8,
+    /// Normal masks: partitions a side (honest: 1..=16 from it), and
+    /// arbitrary classes, sizes and spheres.
+    partitions: u8,
+    raw_classes: Vec<u16>,
+    raw_sizes: Vec<[F; 2]>,
+    raw_spheres: Vec<[F; 4]>,
 }
 
 fn node_from(n: &NodeIn) -> ClusterNode {
@@ -302,5 +318,142 @@ pub fn run_clusters(input: &ClusterInput) {
             }
         }
         (r, v) => panic!("submit_clusters {r:?} but validate {v:?}"),
+    }
+    run_masks(input, &mesh, &mvp, config, &reference);
+}
+
+/// Honest normal classes of a mesh: each triangle's class from its `f64`
+/// normal, per class its triangles' sizes and sphere.
+fn honest_classes(
+    p: &[Vec3],
+    t: &[[u32; 3]],
+    partitions: u8,
+) -> (Vec<u16>, Vec<[f32; 2]>, Vec<BoundingSphere>) {
+    let n = class_count(partitions);
+    let classes: Vec<u16> = t
+        .iter()
+        .map(|tri| {
+            let q = tri.map(|k| p.get(k as usize).copied());
+            let [Some(a), Some(b), Some(c)] = q else {
+                return NO_CLASS;
+            };
+            // Differences of f32 values are exact in f64.
+            let d = |q: Vec3| {
+                [
+                    f64::from(q.x) - f64::from(a.x),
+                    f64::from(q.y) - f64::from(a.y),
+                    f64::from(q.z) - f64::from(a.z),
+                ]
+            };
+            let (u, v) = (d(b), d(c));
+            classify(
+                [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ],
+                partitions,
+            )
+        })
+        .collect();
+    let mut sizes = vec![[0.0f32; 2]; n];
+    let mut spheres = vec![BoundingSphere::EVERYWHERE; n];
+    for c in 0..n {
+        let tris: Vec<[u32; 3]> = t
+            .iter()
+            .zip(&classes)
+            .filter(|(_, &k)| usize::from(k) == c)
+            .map(|(tri, _)| *tri)
+            .collect();
+        if !tris.is_empty() {
+            sizes[c] = microraster::cull::triangle_sizes(p, &tris);
+            spheres[c] = microraster::cull::triangle_sphere(p, &tris);
+        }
+    }
+    (classes, sizes, spheres)
+}
+
+/// Normal masks: `validate` refuses exactly what `submit_masked` refuses,
+/// with nothing counted or stored; the counters add up; with no culling
+/// the pieces are the reference's; honest classes store a subsequence of
+/// the reference's pieces, in order.
+fn run_masks(
+    input: &ClusterInput,
+    mesh: &Mesh<'_, MeshColors<'_>>,
+    mvp: &microraster::Mat4,
+    config: Config,
+    reference: &Frame<'_, 8>,
+) {
+    let (p, t) = (mesh.positions, mesh.indices);
+    let honest = input.honest || input.never;
+    let partitions = if honest {
+        input.partitions % 16 + 1
+    } else {
+        input.partitions
+    };
+    let (classes, sizes, spheres) = if honest {
+        honest_classes(p, t, partitions)
+    } else {
+        let sphere = |b: &[F; 4]| BoundingSphere {
+            center: Vec3::new(b[0].0, b[1].0, b[2].0),
+            radius: b[3].0,
+        };
+        (
+            input
+                .raw_classes
+                .iter()
+                .take(t.len() + 1)
+                .copied()
+                .collect(),
+            input
+                .raw_sizes
+                .iter()
+                .take(1536)
+                .map(|s| s.map(|f| f.0))
+                .collect(),
+            input.raw_spheres.iter().take(1536).map(sphere).collect(),
+        )
+    };
+    let set = NormalClasses {
+        partitions,
+        classes: &classes,
+        sizes: &sizes,
+        spheres: &spheres,
+    };
+    let valid = set.validate(t.len());
+    if honest {
+        assert_eq!(valid, Ok(()), "honest classes are valid");
+    }
+    let room = usize::from(input.storage) % (t.len() * 7 + 2);
+    let mut st = vec![SetupTriangle::EMPTY; room];
+    let mut frame = Frame::<8>::with_subpixel_bits(config, &mut st).expect("valid size");
+    let mut cache = vec![ProcessedVertex::default(); p.len()];
+    let before = frame.stats();
+    let r = frame.submit_masked(mesh, mvp, &set, 0, &mut cache);
+    let after = frame.stats();
+    match (r, valid) {
+        (Err(Error::InvalidNormalClasses(f)), Err(Error::InvalidNormalClasses(g))) => {
+            assert_eq!(f, g);
+            assert_eq!(before, after, "refused classes count nothing");
+            assert!(frame.triangles().is_empty());
+        }
+        (Err(Error::StorageFull { .. }), Ok(())) => {
+            assert_eq!(before, after, "a failed submission counts nothing");
+            assert!(frame.triangles().is_empty());
+        }
+        (Ok(()), Ok(())) => {
+            check_accounting(&before, &after, t.len() as u64);
+            let (got, want) = (frame.triangles(), reference.triangles());
+            if config.cull == CullMode::None && config.detail == 0 {
+                assert_eq!(after, reference.stats(), "nothing masked");
+                assert_eq!(got, want);
+            } else if honest {
+                let mut it = want.iter();
+                for g in got {
+                    assert!(it.any(|w| w == g), "a piece the reference does not store");
+                }
+            }
+        }
+        (r, v) => panic!("submit_masked {r:?} but validate {v:?}"),
     }
 }

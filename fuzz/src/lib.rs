@@ -948,6 +948,7 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         culled_cluster: b.culled_cluster - a.culled_cluster,
         culled_hierarchy: b.culled_hierarchy - a.culled_hierarchy,
         culled_detail: b.culled_detail - a.culled_detail,
+        culled_mask: b.culled_mask - a.culled_mask,
     }
 }
 
