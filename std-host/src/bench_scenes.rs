@@ -246,6 +246,7 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spi
             bounds,
             mvp: Mat4::IDENTITY,
             clusters: None,
+            normal_classes: None,
         }],
         clip_tris: Vec::new(),
     };
@@ -376,6 +377,7 @@ pub fn quad_scene() -> Scene {
             bounds,
             mvp: Mat4::IDENTITY,
             clusters: None,
+            normal_classes: None,
         }],
         clip_tris: Vec::new(),
     }

@@ -252,6 +252,13 @@ pub struct RenderArgs {
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
 
+    /// Skip back-facing triangles before transform by normal masks: their
+    /// normals in 6·N² classes (N partitions a side, 1 to 16), a frame's
+    /// back classes one bit each (see docs/culling.md).
+    #[arg(long, value_name = "N", conflicts_with = "cull_clusters",
+          value_parser = clap::value_parser!(u8).range(1..=16))]
+    pub normal_masks: Option<u8>,
+
     /// Detail culling (lossy; 0: off): drop objects, and with
     /// --cull-clusters clusters, whose projection is provably less than PX
     /// pixels across, before transform.
@@ -491,6 +498,13 @@ pub struct BenchArgs {
     /// cones, at the leaves or down the tree.
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
+
+    /// Skip back-facing triangles before transform by normal masks: their
+    /// normals in 6·N² classes (N partitions a side, 1 to 16), a frame's
+    /// back classes one bit each (see docs/culling.md).
+    #[arg(long, value_name = "N", conflicts_with = "cull_clusters",
+          value_parser = clap::value_parser!(u8).range(1..=16))]
+    pub normal_masks: Option<u8>,
 
     /// Detail culling (lossy; 0: off): drop objects, and with
     /// --cull-clusters clusters, whose projection is provably less than PX
@@ -841,6 +855,23 @@ pub struct CullArgs {
     /// such row).
     #[arg(long, value_name = "PX", default_value_t = 0)]
     pub detail: u16,
+
+    /// Also measure normal masks of these partitions a side (rows "normal
+    /// masks, N"; an empty list: none).
+    #[arg(long, value_name = "N,..", value_delimiter = ',', default_value = "4,8,16",
+          value_parser = clap::value_parser!(u8).range(1..=16))]
+    pub normal_masks: Vec<u8>,
+
+    /// Sector heights for the normal masks' sector table: rows per
+    /// sector (each strip its own mask; the frame height or more is the
+    /// whole frame).
+    #[arg(
+        long,
+        value_name = "ROWS,..",
+        value_delimiter = ',',
+        default_value = "240,60,16"
+    )]
+    pub sector_rows: Vec<u32>,
 
     /// Also write the measurements as JSON.
     #[arg(long, value_name = "FILE")]

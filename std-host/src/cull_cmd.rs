@@ -18,8 +18,11 @@
 
 use crate::cli::CullArgs;
 use crate::cluster::{self, ClusterOptions, ClusteredMesh};
+use crate::normal_mask::{self, NormalClassData};
 use microraster::cull::{Detail, Eye, Visit};
+use microraster::normal_mask::NO_CLASS;
 use microraster::prelude::*;
+use microraster::BackMask;
 use microraster::{
     BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
     ProcessedVertex, SetupTriangle, Stats, Vec3,
@@ -46,6 +49,9 @@ pub enum Method {
     /// Culling volumes, tree top-down, with detail culling (lossy; only
     /// with `--detail`).
     Detail,
+    /// Normal masks of this many partitions a side, on the clustered
+    /// mesh's triangle order (`--normal-masks`).
+    Mask(u8),
 }
 
 impl Method {
@@ -63,7 +69,7 @@ impl Method {
     /// frame's `Config::detail`).
     fn cull(self) -> Option<ClusterCull> {
         let (test, hierarchy) = match self {
-            Method::Source | Method::Clustered => return None,
+            Method::Source | Method::Clustered | Method::Mask(_) => return None,
             Method::Volumes => (ClusterTest::Volumes, false),
             Method::VolumesTree | Method::Detail => (ClusterTest::Volumes, true),
             Method::Cones => (ClusterTest::Cones, false),
@@ -72,8 +78,8 @@ impl Method {
         Some(ClusterCull { test, hierarchy })
     }
 
-    fn label(self) -> &'static str {
-        match self {
+    fn label(self) -> String {
+        let s = match self {
             Method::Source => "per triangle, source mesh",
             Method::Clustered => "per triangle, clustered mesh",
             Method::Volumes => "culling volumes, leaves",
@@ -81,7 +87,9 @@ impl Method {
             Method::Cones => "normal cones, leaves",
             Method::ConesTree => "normal cones, tree",
             Method::Detail => "culling volumes, tree, detail",
-        }
+            Method::Mask(n) => return format!("normal masks, N = {n}"),
+        };
+        s.to_string()
     }
 }
 
@@ -129,6 +137,24 @@ pub struct ModelReport {
     pub t_over_r: f64,
     /// The rows.
     pub rows: Vec<Row>,
+    /// Normal masks: per partitions, the bytes of the data, and the mean
+    /// share of the triangles masked per sector for each of
+    /// `--sector-rows`, exact and without the size guard.
+    pub masks: Vec<MaskReport>,
+}
+
+/// Normal masks of one partition count, by sector height.
+#[derive(Clone, Debug, Serialize)]
+pub struct MaskReport {
+    /// Partitions a side.
+    pub partitions: u8,
+    /// Bytes of the precomputed data (class ids, sizes, spheres).
+    pub data_bytes: usize,
+    /// Triangles left out of every class (never masked).
+    pub exempt: usize,
+    /// Per `--sector-rows`: the sectors, and the share of triangles
+    /// masked per sector (mean), exact and without the size guard.
+    pub sectors: Vec<(u32, f64, f64)>,
 }
 
 /// Runs the command.
@@ -190,6 +216,7 @@ pub fn cameras(positions: &[Vec3], n: usize, dist: f32, aspect: f32) -> Result<V
 struct Case<'a> {
     mesh: Mesh<'a>,
     set: Option<(&'a ClusteredMesh, ClusterCull)>,
+    classes: Option<&'a NormalClassData>,
     /// The frame's settings (with detail culling for [`Method::Detail`]).
     config: Config,
 }
@@ -201,9 +228,10 @@ fn submit(
     mvp: &Mat4,
     cache: &mut [ProcessedVertex],
 ) -> Result<Stats, String> {
-    match case.set {
-        None => frame.submit_mesh_cached(&case.mesh, mvp, 0, cache),
-        Some((c, cull)) => frame.submit_clusters(&case.mesh, mvp, &c.set(), cull, 0, cache),
+    match (case.set, case.classes) {
+        (Some((c, cull)), _) => frame.submit_clusters(&case.mesh, mvp, &c.set(), cull, 0, cache),
+        (None, Some(c)) => frame.submit_masked(&case.mesh, mvp, &c.set(), 0, cache),
+        (None, None) => frame.submit_mesh_cached(&case.mesh, mvp, 0, cache),
     }
     .map_err(|e| e.to_string())?;
     Ok(frame.stats())
@@ -211,6 +239,20 @@ fn submit(
 
 /// Vertices a frame transforms.
 fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
+    if let Some(c) = case.classes {
+        let mask = BackMask::for_frame::<8>(mvp, &case.config, None, &c.set());
+        let mut seen = vec![false; case.mesh.positions.len()];
+        for (t, &k) in case.mesh.indices.iter().zip(&c.classes) {
+            if !mask.contains(k) {
+                for &v in t {
+                    if let Some(s) = seen.get_mut(v as usize) {
+                        *s = true;
+                    }
+                }
+            }
+        }
+        return seen.iter().filter(|&&s| s).count();
+    }
     let Some((c, cull)) = case.set else {
         return case.mesh.positions.len();
     };
@@ -273,11 +315,25 @@ fn measure(
     if args.detail > 0 {
         methods.push(Method::Detail);
     }
+    let class_data: Vec<NormalClassData> = args
+        .normal_masks
+        .iter()
+        .map(|&n| normal_mask::build(&clustered.positions, &clustered.indices, n))
+        .collect::<Result<_, _>>()?;
+    methods.extend(args.normal_masks.iter().map(|&n| Method::Mask(n)));
     let cases: Vec<Case<'_>> = methods
         .iter()
         .map(|m| Case {
             mesh: if *m == Method::Source { source } else { cmesh },
             set: m.cull().map(|c| (clustered, c)),
+            classes: match m {
+                Method::Mask(n) => args
+                    .normal_masks
+                    .iter()
+                    .position(|k| k == n)
+                    .map(|i| &class_data[i]),
+                _ => None,
+            },
             config: Config {
                 detail: if *m == Method::Detail { args.detail } else { 0 },
                 ..config
@@ -317,7 +373,7 @@ fn measure(
             frame
                 .render_rows(0, h, &mut color, &mut depth[..])
                 .map_err(|e| e.to_string())?;
-            let skipped = s.culled_cluster + s.culled_hierarchy + s.culled_detail;
+            let skipped = s.culled_cluster + s.culled_hierarchy + s.culled_detail + s.culled_mask;
             row.triangles_to_transform += (s.submitted - skipped) as f64 / cams;
             row.removed_before_transform += skipped as f64 / s.submitted.max(1) as f64 / cams;
             row.vertices_transformed += vertices_transformed(case, mvp) as f64 / cams;
@@ -382,6 +438,10 @@ fn measure(
     let t = t0.elapsed().as_secs_f64() / tests;
     std::hint::black_box(backs);
     let r = rows[1].geometry_ms[0] * 1e-3 / clustered.indices.len().max(1) as f64;
+    let masks = class_data
+        .iter()
+        .map(|d| mask_sectors(d, &mvps, config, &args.sector_rows))
+        .collect();
     Ok(ModelReport {
         model: name.to_string(),
         triangles: indices.len(),
@@ -394,7 +454,48 @@ fn measure(
         data_bytes: clustered.data_bytes(),
         t_over_r: t / r,
         rows,
+        masks,
     })
+}
+
+/// The share of triangles the masks of `d` skip per sector, for each
+/// sector height, over the cameras (sectors are the rows of a strip
+/// renderer, with its slab).
+fn mask_sectors(d: &NormalClassData, mvps: &[Mat4], config: Config, heights: &[u32]) -> MaskReport {
+    let n = d.classes.len().max(1) as f64;
+    let h = config.height;
+    let sectors = heights
+        .iter()
+        .map(|&rows| {
+            let rows = rows.clamp(1, h);
+            let (mut exact, mut geometric, mut count) = (0.0, 0.0, 0usize);
+            for mvp in mvps {
+                for y0 in (0..h).step_by(rows as usize) {
+                    let y1 = (y0 + rows).min(h);
+                    let slab = (rows < h).then(|| {
+                        (
+                            1.0 - 2.0 * (y0 as f32 + 0.25) / h as f32,
+                            1.0 - 2.0 * (y1 as f32 - 0.25) / h as f32,
+                        )
+                    });
+                    let share = |m: BackMask| {
+                        d.classes.iter().filter(|&&k| m.contains(k)).count() as f64 / n
+                    };
+                    exact += share(BackMask::for_frame::<8>(mvp, &config, slab, &d.set()));
+                    geometric += share(BackMask::geometric::<8>(mvp, &config, slab, &d.set()));
+                    count += 1;
+                }
+            }
+            let c = count.max(1) as f64;
+            (h.div_ceil(rows), exact / c, geometric / c)
+        })
+        .collect();
+    MaskReport {
+        partitions: d.partitions,
+        data_bytes: d.data_bytes(),
+        exempt: d.classes.iter().filter(|&&k| k == NO_CLASS).count(),
+        sectors,
+    }
 }
 
 /// `[median, min, max]`.
@@ -441,7 +542,7 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
                 if row.method == Method::Detail {
                     format!("{} {} px", row.method.label(), args.detail)
                 } else {
-                    row.method.label().to_string()
+                    row.method.label()
                 },
                 row.triangles_to_transform,
                 row.removed_before_transform * 100.0,
@@ -462,6 +563,22 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
                     _ => row.frames_differing.to_string(),
                 },
             );
+        }
+        if !r.masks.is_empty() {
+            s += "\nNormal masks by sector (each sector a strip with its own mask): share of the triangles masked per sector, exact (with the size guard) / the lecture's mask alone (no size guard, not exact)\n\n| N | data | exempt triangles |";
+            for &(k, _, _) in &r.masks[0].sectors {
+                s += &format!(" {k} sector{} |", if k == 1 { "" } else { "s" });
+            }
+            s += "\n|---:|---:|---:|";
+            s += &"---:|".repeat(r.masks[0].sectors.len());
+            s += "\n";
+            for m in &r.masks {
+                s += &format!("| {} | {} B | {} |", m.partitions, m.data_bytes, m.exempt);
+                for &(_, e, g) in &m.sectors {
+                    s += &format!(" {:.1} % / {:.1} % |", e * 100.0, g * 100.0);
+                }
+                s += "\n";
+            }
         }
     }
     s

@@ -33,6 +33,7 @@ pub mod bench_scenes;
 pub mod cli;
 pub mod cliptris;
 pub mod cluster;
+pub mod normal_mask;
 pub mod cull_cmd;
 pub mod image_out;
 pub mod obj;

@@ -88,9 +88,8 @@ pub fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
         }
     };
     for (i, o) in scene.objects.iter().enumerate() {
-        push(o.indices.len(), o.clusters.is_some(), &|r| {
-            Piece::Object(i, r)
-        });
+        let whole = o.clusters.is_some() || o.normal_classes.is_some();
+        push(o.indices.len(), whole, &|r| Piece::Object(i, r));
     }
     push(scene.clip_tris.len(), false, &|r| Piece::ClipTris(r));
     chunks
@@ -127,6 +126,11 @@ pub fn fill<const S: u32, K: Submit<S>>(
                     // Its own scratch cache: the vertex stage skipped it.
                     let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
                     frame.submit_clusters(&o.mesh(), &o.mvp, &c.set(), c.cull, id, &mut cache)?;
+                    continue;
+                }
+                if let Some(c) = &o.normal_classes {
+                    let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
+                    frame.submit_masked(&o.mesh(), &o.mvp, &c.set(), id, &mut cache)?;
                     continue;
                 }
                 match caches.get(*i).copied().flatten() {
@@ -541,8 +545,12 @@ fn vertex_stage<'c, const S: u32>(
     }
     let mut out = Vec::with_capacity(scene.objects.len());
     for (o, cache) in scene.objects.iter().zip(caches.iter_mut()) {
-        // Clustered objects process their vertices as their clusters pass.
-        if o.clusters.is_some() || o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp)) {
+        // Clustered and masked objects process their vertices as their
+        // triangles pass.
+        if o.clusters.is_some()
+            || o.normal_classes.is_some()
+            || o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp))
+        {
             out.push(None);
             continue;
         }

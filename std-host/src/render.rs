@@ -125,6 +125,9 @@ pub struct Counters {
     pub culled_hierarchy: u64,
     /// Dropped before transform by detail culling (`--cull-detail`).
     pub culled_detail: u64,
+    /// Skipped before transform by the frame's normal mask
+    /// (`--normal-masks`).
+    pub culled_mask: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -142,6 +145,7 @@ impl From<&Stats> for Counters {
             culled_cluster: s.culled_cluster,
             culled_hierarchy: s.culled_hierarchy,
             culled_detail: s.culled_detail,
+            culled_mask: s.culled_mask,
         }
     }
 }

@@ -83,6 +83,9 @@ pub fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
         let opts = crate::cluster::ClusterOptions::default();
         crate::cluster::cluster_scene(&mut scene, c.cull(), &opts)?;
     }
+    if let Some(n) = args.normal_masks {
+        crate::normal_mask::mask_scene(&mut scene, n)?;
+    }
     Ok(scene)
 }
 
@@ -318,6 +321,7 @@ fn nonzero(c: &Counters) -> String {
             "cluster below --cull-detail pixels (before transform)",
             c.culled_detail,
         ),
+        ("back-facing normal class (before transform)", c.culled_mask),
         ("degenerate", c.culled_degenerate),
         ("non-finite", c.rejected_nonfinite),
         ("index out of range", c.rejected_index),
@@ -407,6 +411,13 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         }
     }
     let (r, load_warnings) = match args.source() {
+        Source::Obj(_) if args.normal_masks.is_some() => {
+            return Err(
+                "--normal-masks is not yet supported with --obj (lit models); \
+                 use --scene, or `microraster bench --obj FILE --normal-masks N`"
+                    .into(),
+            )
+        }
         Source::Obj(_) if args.cull_clusters.is_some() => {
             return Err(
                 "--cull-clusters is not yet supported with --obj (lit models); \

@@ -34,6 +34,9 @@ pub struct Object {
     /// Cluster culling: the object's triangles are then in cluster order
     /// (see [`crate::cluster::cluster_scene`]).
     pub clusters: Option<std::sync::Arc<ObjectClusters>>,
+    /// Normal masks (see [`crate::normal_mask::mask_scene`]); not with
+    /// `clusters`.
+    pub normal_classes: Option<std::sync::Arc<crate::normal_mask::NormalClassData>>,
 }
 
 /// The clusters of an [`Object`] and how they are tested.
@@ -218,6 +221,7 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
             bounds: mesh.bounds,
             mvp: view_proj * cubes::model_matrix(ops),
             clusters: None,
+            normal_classes: None,
         })
         .collect();
     Ok(Scene {
@@ -275,6 +279,7 @@ pub fn mesh_scene(
             bounds,
             mvp: proj * view,
             clusters: None,
+            normal_classes: None,
         }],
         clip_tris: Vec::new(),
     })

@@ -193,6 +193,9 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
         let opts = crate::cluster::ClusterOptions::default();
         crate::cluster::cluster_scene(&mut bs.scene, c.cull(), &opts)?;
     }
+    if let Some(n) = args.normal_masks {
+        crate::normal_mask::mask_scene(&mut bs.scene, n)?;
+    }
     if bs.spin.is_some() || s.spin != 0.0 {
         let mut spin = bs
             .spin
