@@ -26,8 +26,13 @@
 //! (16 products: "test each class in all four corners of the view
 //! frustum"), every triangle of the class that shows in the sector is
 //! culled by winding, with a facing value of at least `w_min s delta /
-//! sqrt 3` for a unit normal (`delta` the least product, `s` the scale of
-//! the `g_j`, `w_min` over the mesh's sphere). That value goes through the
+//! |m|` for a unit normal (`delta` the least product, `s` the scale of
+//! the `g_j`, `|m|` the longest corner direction of the cell, `w_min` over
+//! the class's sphere). The `g_j` come from the matrix's rows alone, in
+//! `f64` (`corner_directions`: no inverse, and no cancellation against
+//! the eye's position, which a far eye and a near plane would make
+//! large); an eye at infinity (an orthographic matrix) masks nothing.
+//! That value goes through the
 //! clusters' margin ([`MARGIN`]) and size guard: a class is in the mask
 //! only where none of its triangles can snap to the other winding. So the
 //! frame is byte-identical to per-triangle culling (a skipped triangle
@@ -344,32 +349,51 @@ fn class_keeps_winding(
 }
 
 /// The directions `-sign g_j` of the sector's corners `(X, Y)` for `X` in
-/// `rect[0..2]`, `Y` in `rect[2..4]`: `g_j = E_xyz D_w - E_w D_xyz` with
-/// `D = A^-1 (X, Y, 0, 1)` (in `f64`), scaled by `1/s` so the largest
+/// `rect[0..2]`, `Y` in `rect[2..4]`, scaled by `1/s` so the largest
 /// component is 1; a normal `n` faces away at that corner where
-/// `direction . n > 0`. `None` for a singular or badly conditioned
-/// matrix.
+/// `direction . n > 0`.
+///
+/// `g_j . n` is the facing value per unit clip `w` on the ray of clip
+/// points `(X, Y, *, 1)` (the value at `A^-1 (X, Y, 0, 1)`). The ray's
+/// points `P` satisfy `(r_x - X r_w) . P = (r_y - Y r_w) . P = 0`; so does
+/// its point at infinity `(d, 0)` with `d = (m_x - X m_w) x (m_y - Y m_w)`
+/// (`m` the rows' first three columns), where the facing value is `-E_w
+/// n . d` and `w = m_w . d`; both vanish on the eye. So `g_j = -E_w d /
+/// (m_w . d)`: found in `f64` from the matrix alone, with no inverse and
+/// no cancellation against the eye's position (the facing value's scale
+/// `E_w` enters as one factor). `None` for an eye at infinity
+/// (orthographic: `E_w = 0`), a non-finite matrix, or a degenerate
+/// corner ray.
 fn corner_directions(mvp: &Mat4, eye: &Eye, rect: [f32; 4]) -> Option<([[f32; 3]; 4], f32)> {
     let c = &mvp.cols;
-    // a[row][col], f64.
-    let a: [[f64; 4]; 4] = core::array::from_fn(|i| core::array::from_fn(|j| f64::from(c[j][i])));
-    let inv = inverse(&a)?;
-    let e = [eye.xyz[0], eye.xyz[1], eye.xyz[2], eye.w].map(f64::from);
+    let row = |i: usize| [c[0][i], c[1][i], c[2][i]].map(f64::from);
+    let (mx, my, mw) = (row(0), row(1), row(3));
+    let ew = f64::from(eye.w);
     let sign = f64::from(eye.sign);
+    if !(ew != 0.0 && ew.is_finite()) {
+        return None;
+    }
+    let norm2 = |v: [f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let mut g = [[0.0f64; 3]; 4];
     for (k, gk) in g.iter_mut().enumerate() {
         let (x, y) = (f64::from(rect[k % 2]), f64::from(rect[2 + k / 2]));
-        let q = [x, y, 0.0, 1.0];
-        let d: [f64; 4] = core::array::from_fn(|i| (0..4).map(|j| inv[i][j] * q[j]).sum());
-        // The inverse must reproduce the corner (a relative check).
-        for (i, row) in a.iter().enumerate() {
-            let back: f64 = (0..4).map(|j| row[j] * d[j]).sum();
-            let scale: f64 = (0..4).map(|j| (row[j] * d[j]).abs()).sum::<f64>() + 1.0;
-            if !((back - q[i]).abs() <= 1e-9 * scale) {
-                return None;
-            }
+        let a: [f64; 3] = core::array::from_fn(|i| mx[i] - x * mw[i]);
+        let b: [f64; 3] = core::array::from_fn(|i| my[i] - y * mw[i]);
+        let d = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let den = dot(mw, d);
+        // Well-conditioned only: the planes far from parallel, the ray
+        // far from perpendicular to the view axis (f64 then leaves errors
+        // near 2^-30 relative, far inside the allowance).
+        let (nd, na, nb, nw) = (norm2(d), norm2(a), norm2(b), norm2(mw));
+        if !(nd > 1e-12 * na * nb && den * den > 1e-12 * nw * nd) {
+            return None;
         }
-        *gk = core::array::from_fn(|i| -sign * (e[i] * d[3] - e[3] * d[i]));
+        *gk = core::array::from_fn(|i| sign * ew * d[i] / den);
     }
     let s = g.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(s > 0.0 && s.is_finite()) {
@@ -377,33 +401,6 @@ fn corner_directions(mvp: &Mat4, eye: &Eye, rect: [f32; 4]) -> Option<([[f32; 3]
     }
     let dirs = g.map(|v| v.map(|x| (x / s) as f32));
     Some((dirs, s as f32))
-}
-
-/// The inverse of a 4x4 matrix (rows), by cofactors; `None` where the
-/// determinant is zero or not finite.
-fn inverse(a: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
-    let minor = |r: usize, c: usize| -> f64 {
-        let rows: heapless::Vec<usize, 3> = (0..4).filter(|&i| i != r).collect();
-        let cols: heapless::Vec<usize, 3> = (0..4).filter(|&j| j != c).collect();
-        let m = |i: usize, j: usize| a[rows[i]][cols[j]];
-        m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1))
-            - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
-            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0))
-    };
-    let cof: [[f64; 4]; 4] = core::array::from_fn(|i| {
-        core::array::from_fn(|j| {
-            let s = if (i + j) % 2 == 0 { 1.0 } else { -1.0 };
-            s * minor(i, j)
-        })
-    });
-    let det: f64 = (0..4).map(|j| a[0][j] * cof[0][j]).sum();
-    if !(det != 0.0 && det.is_finite()) {
-        return None;
-    }
-    // inverse = adj / det, adj the transposed cofactors.
-    Some(core::array::from_fn(|i| {
-        core::array::from_fn(|j| cof[j][i] / det)
-    }))
 }
 
 #[cfg(test)]
@@ -479,23 +476,5 @@ mod tests {
         assert!(m.is_empty() && !m.contains(0) && !m.contains(NO_CLASS));
         m.words[1] = 1 << 3;
         assert!(m.contains(35) && !m.contains(34) && m.len() == 1);
-    }
-
-    #[test]
-    fn inverse_inverts() {
-        let a = [
-            [2.0, 0.0, 1.0, 0.0],
-            [0.0, 3.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0, 0.0],
-            [0.0, 0.0, -1.0, 2.0],
-        ];
-        let inv = inverse(&a).unwrap();
-        for i in 0..4 {
-            for j in 0..4 {
-                let v: f64 = (0..4).map(|k| a[i][k] * inv[k][j]).sum();
-                assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12);
-            }
-        }
-        assert!(inverse(&[[1.0; 4]; 4]).is_none());
     }
 }

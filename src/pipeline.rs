@@ -352,8 +352,9 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             return self.submit_processed_mesh(mesh, first_id, cache);
         }
         // The kept triangles' vertices marked stale, then processed in
-        // runs (as `submit_clusters` does with a vertex list): no other
-        // entry is read.
+        // runs (as `submit_clusters` does with a vertex list; an old
+        // non-finite entry is processed again, to the same entry): a kept
+        // triangle reads only entries processed now.
         for (idx, &c) in mesh.indices.iter().zip(classes.classes) {
             if !mask.contains(c) {
                 for &k in idx {

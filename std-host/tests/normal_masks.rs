@@ -205,13 +205,16 @@ fn a_sliver_that_snapping_flips_is_not_masked() {
     const S: u32 = 4;
     let (w, h) = (32u32, 24u32);
     let config = Config::new(w, h);
-    // Window pixels to NDC (identity matrix: clip = object space).
+    // Window pixels to object space: the plane z = -2 before a camera at
+    // the origin with a field of view of 0.5 rad (narrow, so the cells
+    // around -z face away from the whole frustum).
+    let fov = 0.5f32;
+    let mvp = Mat4::perspective(fov, w as f32 / h as f32, 0.5, 10.0);
+    let t = f64::from((fov / 2.0).tan()) * 2.0;
+    let aspect = f64::from(w) / f64::from(h);
     let ndc = |x: f64, y: f64| {
-        Vec3::new(
-            (2.0 * x / f64::from(w) - 1.0) as f32,
-            (1.0 - 2.0 * y / f64::from(h)) as f32,
-            0.0,
-        )
+        let (nx, ny) = (2.0 * x / f64::from(w) - 1.0, 1.0 - 2.0 * y / f64::from(h));
+        Vec3::new((nx * aspect * t) as f32, (ny * t) as f32, -2.0)
     };
     let mut found = 0;
     for k in 0..400 {
@@ -231,7 +234,7 @@ fn a_sliver_that_snapping_flips_is_not_masked() {
                 ..ClusteredMesh::default()
             };
             let c = normal_mask::build(&m.positions, &m.indices, 4).unwrap();
-            let lecture = BackMask::geometric::<S>(&Mat4::IDENTITY, &config, None, &c.set());
+            let lecture = BackMask::geometric::<S>(&mvp, &config, None, &c.set());
             if !lecture.contains(c.classes[0]) {
                 continue;
             }
@@ -249,11 +252,11 @@ fn a_sliver_that_snapping_flips_is_not_masked() {
                 let mut cache = vec![ProcessedVertex::default(); 3];
                 if masked {
                     frame
-                        .submit_masked(&mesh, &Mat4::IDENTITY, &c.set(), 0, &mut cache)
+                        .submit_masked(&mesh, &mvp, &c.set(), 0, &mut cache)
                         .unwrap();
                 } else {
                     frame
-                        .submit_mesh_cached(&mesh, &Mat4::IDENTITY, 0, &mut cache)
+                        .submit_mesh_cached(&mesh, &mvp, 0, &mut cache)
                         .unwrap();
                 }
                 let mut color = vec![Rgb888::BLACK; (w * h) as usize];
