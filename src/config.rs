@@ -196,6 +196,14 @@ pub enum Error {
     /// Normal classes ([`NormalClasses`](crate::normal_mask::NormalClasses))
     /// that do not fit the mesh.
     InvalidNormalClasses(crate::normal_mask::ClassFault),
+    /// Fewer hi-z tiles than the strip needs
+    /// ([`tiles_for`](crate::occlusion::tiles_for)).
+    HiZSize {
+        /// Tiles needed.
+        expected: usize,
+        /// Tiles given.
+        actual: usize,
+    },
     /// [`RasterMode::Clipless`] given to a [`Frame`](crate::Frame), whose
     /// setup storage holds snapped triangles only (draw clipless triangles
     /// with a [`StripRenderer`](crate::StripRenderer)), or to any receiver
@@ -273,6 +281,9 @@ impl core::fmt::Display for Error {
                     write!(f, "cluster node {i} does not tile its clusters")
                 }
             },
+            Error::HiZSize { expected, actual } => {
+                write!(f, "{actual} hi-z tiles given, the strip needs {expected}")
+            }
             Error::InvalidNormalClasses(fault) => match fault {
                 crate::normal_mask::ClassFault::Partitions => {
                     write!(f, "normal classes need 1 to 16 partitions a side")

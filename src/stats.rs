@@ -56,6 +56,9 @@ pub struct Stats {
     /// Skipped before transform because its normal's class is in the
     /// frame's back mask ([`Submit::submit_masked`](crate::Submit::submit_masked)).
     pub culled_mask: u64,
+    /// Skipped before transform because the strip's hi-z hides its object
+    /// ([`Occluder`](crate::occlusion::Occluder)).
+    pub culled_occlusion: u64,
 }
 
 impl Stats {
@@ -74,6 +77,7 @@ impl Stats {
             self.culled_hierarchy,
             self.culled_detail,
             self.culled_mask,
+            self.culled_occlusion,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
@@ -96,6 +100,7 @@ impl Stats {
             culled_hierarchy: self.culled_hierarchy.saturating_add(o.culled_hierarchy),
             culled_detail: self.culled_detail.saturating_add(o.culled_detail),
             culled_mask: self.culled_mask.saturating_add(o.culled_mask),
+            culled_occlusion: self.culled_occlusion.saturating_add(o.culled_occlusion),
         }
     }
 }

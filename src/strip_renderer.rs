@@ -29,7 +29,7 @@ use crate::stats::{RenderStats, Stats};
 /// A strip renderer's sink: its rows, its fragment shader, and the pixels
 /// written so far.
 pub struct StripSink<'b, C, D: ?Sized, const S: u32, F = VertexColor> {
-    strip: Strip<'b, C, D>,
+    pub(crate) strip: Strip<'b, C, D>,
     fragment: F,
     render: RenderStats,
 }
@@ -93,9 +93,9 @@ impl<
 /// assert!(strip.render_stats().pixels_written > 0);
 /// ```
 pub struct StripRenderer<'b, C, D: ?Sized, const S: u32 = 8, const N: usize = 3, F = VertexColor> {
-    stage: Stage,
-    sink: StripSink<'b, C, D, S, F>,
-    stats: Stats,
+    pub(crate) stage: Stage,
+    pub(crate) sink: StripSink<'b, C, D, S, F>,
+    pub(crate) stats: Stats,
 }
 
 impl<C, D: ?Sized, const S: u32, const N: usize, F> core::fmt::Debug

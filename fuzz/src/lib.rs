@@ -949,6 +949,7 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         culled_hierarchy: b.culled_hierarchy - a.culled_hierarchy,
         culled_detail: b.culled_detail - a.culled_detail,
         culled_mask: b.culled_mask - a.culled_mask,
+        culled_occlusion: b.culled_occlusion - a.culled_occlusion,
     }
 }
 

@@ -1,0 +1,434 @@
+//! Occlusion culling: objects hidden behind what a strip already holds are
+//! skipped before any of their vertices is transformed.
+//!
+//! Design note: a [`StripRenderer`] draws each object into its strip at
+//! once, so when the next object comes the strip's depth buffer already
+//! says how near the nearest drawn surface is at every pixel. An
+//! [`Occluder`] keeps a coarse copy of it: the largest depth word
+//! ("hi-z") of every [`HIZ_TILE`] x [`HIZ_TILE`] tile of the strip, in a
+//! slice of [`HiZTile`]s the caller owns ([`tiles_for`] of them: 80 for a
+//! 320x16 strip, 640 bytes). Before an object is submitted its bounding
+//! sphere is projected to a conservative [`ScreenBound`]: a pixel
+//! rectangle holding every pixel centre any of its triangles can cover,
+//! and a depth `near` below every depth any of those pixels can get. If
+//! that depth fails the depth test against the largest stored depth of
+//! every tile the rectangle touches, no pixel of the object can pass it:
+//! the object is counted in [`Stats::culled_occlusion`] and nothing of it
+//! is transformed. Otherwise it is drawn, and the tiles its rectangle
+//! touches are marked stale; a stale tile is read again from the depth
+//! buffer the next time a test needs it. So a test costs the tiles it
+//! touches, and the buffer is read only where something was drawn since.
+//!
+//! Conservative, so the frame is the one the plain submissions draw
+//! (a property test compares them byte for byte, `tests/occlusion.rs`):
+//! - the bound is computed from the sphere's bounding box's eight corners
+//!   in `f64`, where a projection's extremes over a box in front of the eye
+//!   lie (`x / w`, `y / w` and `z / w` are linear-fractional: monotone
+//!   along every segment where `w > 0`). The vertex stage's `f32` error
+//!   (`γ` times the magnitudes, as [`BoundingSphere::outside_frustum`]
+//!   bounds it) widens the rectangle, with one more pixel for snapping
+//!   and pixel centres, and lowers `near`, with 2^18 `Z32` units (four
+//!   `u16` LSBs) more for the depth plane's interpolation and stepping,
+//!   whose error stays below a quarter of a `u16` LSB at a covered pixel
+//!   (see [`crate::raster`]). Clipped vertices lie on the edges of the
+//!   triangles they cut, so inside the same box;
+//! - a sphere not wholly in front of the eye (with margin), or not finite,
+//!   has no bound: its object is drawn and marks every tile stale;
+//! - only [`DepthFunc::Less`] and [`DepthFunc::LessEqual`] hide; under any
+//!   other test nothing is culled.
+//!
+//! The caller keeps two promises, as for [`Mesh::bounds`]: the sphere
+//! bounds the object, and whatever [`Occluder::submit_with`]'s closure
+//! draws is the object the sphere bounds. The occluder borrows the
+//! renderer, so nothing else draws into the strip while it lives. Objects
+//! submitted front to back hide the most.
+
+use crate::color::PixelFormat;
+use crate::config::{Config, Error};
+use crate::depth::{DepthFunc, DepthWord};
+use crate::math::Mat4;
+use crate::mesh::{BoundingSphere, Mesh, ProcessedVertex};
+use crate::pipeline::Submit;
+use crate::shade::{Attributes, FragmentShader};
+use crate::stats::Stats;
+use crate::strip_renderer::StripRenderer;
+
+/// The side of a hi-z tile, in pixels.
+pub const HIZ_TILE: u32 = 8;
+
+/// One tile's largest depth key, and whether it is up to date. The
+/// default is stale.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HiZTile {
+    max: u32,
+    fresh: bool,
+}
+
+/// The hi-z tiles a strip of `width` columns and `rows` rows needs.
+pub const fn tiles_for(width: u32, rows: u32) -> usize {
+    (width.div_ceil(HIZ_TILE) as usize) * (rows.div_ceil(HIZ_TILE) as usize)
+}
+
+/// The vertex stage's `f32` error relative to the magnitudes, with room
+/// to spare (as [`BoundingSphere::outside_frustum`] uses).
+const GAMMA: f64 = 16.0 / 16_777_216.0;
+
+/// The depth interpolation's margin, in `Z32` units: four `u16` LSBs.
+const Z_MARGIN: u32 = 1 << 18;
+
+/// A conservative screen bound of an object: every pixel centre one of its
+/// triangles covers lies in columns `x0..x1` and rows `y0..y1` (clamped to
+/// the frame), and every depth it gets there is at least `near` (`Z32`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScreenBound {
+    /// First column.
+    pub x0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last row.
+    pub y1: u32,
+    /// A lower bound of the object's window depths, `Z32`.
+    pub near: u32,
+}
+
+impl ScreenBound {
+    /// The bound of everything the sphere holds under `mvp` in a frame of
+    /// `config`'s size, or `None` where there is none: a sphere reaching
+    /// behind the eye (or within rounding of it), or anything not finite.
+    pub fn of_sphere(sphere: &BoundingSphere, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
+        let r = sphere.radius as f64;
+        let c = [
+            sphere.center.x as f64,
+            sphere.center.y as f64,
+            sphere.center.z as f64,
+        ];
+        if !(r >= 0.0 && r.is_finite() && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
+            return None;
+        }
+        let m = mvp.rows();
+        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
+        let mag = |i: usize| -> f64 { (0..4).map(|j| (m[i][j] as f64).abs() * p_abs[j]).sum() };
+        let err = [
+            mag(0) * GAMMA,
+            mag(1) * GAMMA,
+            mag(2) * GAMMA,
+            mag(3) * GAMMA,
+        ];
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut w_min = f64::INFINITY;
+        for k in 0..8 {
+            let q = [
+                c[0] + if k & 1 == 0 { -r } else { r },
+                c[1] + if k & 2 == 0 { -r } else { r },
+                c[2] + if k & 4 == 0 { -r } else { r },
+                1.0,
+            ];
+            let row = |i: usize| -> f64 { (0..4).map(|j| m[i][j] as f64 * q[j]).sum() };
+            let w = row(3);
+            w_min = w_min.min(w);
+            for (i, (l, h)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
+                let v = row(i) / w;
+                *l = l.min(v);
+                *h = h.max(v);
+            }
+        }
+        // Every computed w stays positive, with a margin.
+        let w_low = w_min - err[3];
+        if !(w_low > 0.0 && w_low.is_finite()) {
+            return None;
+        }
+        // |x_f / w_f - x / w| <= (e_x + |x / w| e_w) / (w - e_w).
+        let ndc_err = |i: usize| (err[i] + lo[i].abs().max(hi[i].abs()) * err[3]) / w_low;
+        let (half_w, half_h) = (config.width as f64 * 0.5, config.height as f64 * 0.5);
+        // One pixel for snapping (half a subpixel), the pixel centres and
+        // the viewport transform's own rounding.
+        let ex = ndc_err(0) * half_w + 1.0;
+        let ey = ndc_err(1) * half_h + 1.0;
+        let px = |v: f64| v * half_w + half_w;
+        let py = |v: f64| half_h - v * half_h;
+        // Clamped to [0, n] and truncated: the floor; one more for the
+        // ceiling (at most one column or row too many).
+        let floor = |v: f64, n: u32| -> u32 {
+            if v.is_nan() {
+                0
+            } else {
+                v.clamp(0.0, n as f64) as u32
+            }
+        };
+        let ceil = |v: f64, n: u32| -> u32 {
+            if v.is_nan() {
+                n
+            } else {
+                (floor(v, n) + 1).min(n)
+            }
+        };
+        let x0 = floor(px(lo[0]) - ex, config.width);
+        let x1 = ceil(px(hi[0]) + ex, config.width);
+        let y0 = floor(py(hi[1]) - ey, config.height);
+        let y1 = ceil(py(lo[1]) + ey, config.height);
+        // Window depth z / w / 2 + 1/2; its f32 evaluation errs by a few
+        // ulps of 1 (2^-20 covers them).
+        let z = lo[2] * 0.5 + 0.5 - ndc_err(2) * 0.5 - 1.0 / 1_048_576.0;
+        if !(ex.is_finite() && ey.is_finite() && z.is_finite()) {
+            return None;
+        }
+        let near = if z <= 0.0 {
+            0
+        } else {
+            ((z * 4_294_967_296.0).min(4_294_967_295.0) as u32).saturating_sub(Z_MARGIN)
+        };
+        Some(ScreenBound {
+            x0,
+            x1,
+            y0,
+            y1,
+            near,
+        })
+    }
+}
+
+/// A [`StripRenderer`] with hi-z tiles: submits objects, skipping those
+/// hidden behind what the strip holds (see the [module](self)). Made by
+/// [`StripRenderer::occluder`].
+pub struct Occluder<'r, 'b, C, W, const S: u32, const N: usize, F> {
+    renderer: &'r mut StripRenderer<'b, C, [W], S, N, F>,
+    tiles: &'r mut [HiZTile],
+    /// Tile columns.
+    cols: u32,
+}
+
+impl<C, W, const S: u32, const N: usize, F> core::fmt::Debug for Occluder<'_, '_, C, W, S, N, F> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Occluder")
+            .field("renderer", &self.renderer)
+            .field("tiles", &self.tiles.len())
+            .finish()
+    }
+}
+
+impl<'b, C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShader<N>>
+    StripRenderer<'b, C, [W], S, N, F>
+{
+    /// An [`Occluder`] over this renderer's strip, keeping its hi-z in
+    /// `tiles` (at least [`tiles_for`] the strip's columns and rows; any
+    /// contents: every tile starts stale). Fewer is
+    /// [`Error::HiZSize`].
+    pub fn occluder<'r>(
+        &'r mut self,
+        tiles: &'r mut [HiZTile],
+    ) -> Result<Occluder<'r, 'b, C, W, S, N, F>, Error> {
+        let s = &self.sink.strip;
+        let (w, h) = (s.x1 - s.x0, s.y1 - s.y0);
+        let needed = tiles_for(w, h);
+        if tiles.len() < needed {
+            return Err(Error::HiZSize {
+                expected: needed,
+                actual: tiles.len(),
+            });
+        }
+        let tiles = &mut tiles[..needed];
+        tiles.fill(HiZTile::default());
+        Ok(Occluder {
+            renderer: self,
+            tiles,
+            cols: w.div_ceil(HIZ_TILE),
+        })
+    }
+}
+
+impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShader<N>>
+    Occluder<'_, '_, C, W, S, N, F>
+{
+    /// The renderer's counters so far.
+    pub fn stats(&self) -> Stats {
+        self.renderer.stats()
+    }
+
+    /// The tiles `bound` touches in this strip, as tile columns and rows
+    /// (half-open), or `None` if it misses the strip.
+    fn tile_range(&self, b: &ScreenBound) -> Option<([u32; 2], [u32; 2])> {
+        let s = &self.renderer.sink.strip;
+        let (x0, x1) = (b.x0.max(s.x0), b.x1.min(s.x1));
+        let (y0, y1) = (b.y0.max(s.y0), b.y1.min(s.y1));
+        if x0 >= x1 || y0 >= y1 {
+            return None;
+        }
+        Some((
+            [(x0 - s.x0) / HIZ_TILE, (x1 - s.x0).div_ceil(HIZ_TILE)],
+            [(y0 - s.y0) / HIZ_TILE, (y1 - s.y0).div_ceil(HIZ_TILE)],
+        ))
+    }
+
+    /// Whether an object with screen bound `b` would have no pixel pass
+    /// the depth test in this strip. `false` where it misses the strip.
+    pub fn hides(&mut self, b: &ScreenBound) -> bool {
+        let strict = match self.renderer.sink.strip.depth_func {
+            DepthFunc::Less => false,
+            DepthFunc::LessEqual => true,
+            _ => return false,
+        };
+        let Some(([tx0, tx1], [ty0, ty1])) = self.tile_range(b) else {
+            return false;
+        };
+        let near = W::from_z32(b.near).key();
+        for ty in ty0..ty1 {
+            for tx in tx0..tx1 {
+                let max = self.tile_max(tx, ty);
+                if near < max || (strict && near == max) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// The largest key of tile `(tx, ty)`, read again if stale.
+    fn tile_max(&mut self, tx: u32, ty: u32) -> u32 {
+        let i = (ty * self.cols + tx) as usize;
+        let Some(t) = self.tiles.get(i).copied() else {
+            return u32::MAX;
+        };
+        if t.fresh {
+            return t.max;
+        }
+        let s = &self.renderer.sink.strip;
+        let (w, h) = (s.x1 - s.x0, s.y1 - s.y0);
+        let (c0, c1) = (tx * HIZ_TILE, ((tx + 1) * HIZ_TILE).min(w));
+        let mut max = 0u32;
+        for y in ty * HIZ_TILE..((ty + 1) * HIZ_TILE).min(h) {
+            let row = y as usize * s.width;
+            let Some(words) = s.depth.get(row + c0 as usize..row + c1 as usize) else {
+                return u32::MAX;
+            };
+            max = words.iter().fold(max, |m, v| m.max(v.key()));
+        }
+        self.tiles[i] = HiZTile { max, fresh: true };
+        max
+    }
+
+    /// Marks the tiles `b` touches stale (every tile without a bound).
+    fn touched(&mut self, b: Option<&ScreenBound>) {
+        match b {
+            None => self.tiles.fill(HiZTile::default()),
+            Some(b) => {
+                if let Some(([tx0, tx1], [ty0, ty1])) = self.tile_range(b) {
+                    for ty in ty0..ty1 {
+                        let row = (ty * self.cols) as usize;
+                        if let Some(ts) = self.tiles.get_mut(row + tx0 as usize..row + tx1 as usize)
+                        {
+                            ts.fill(HiZTile::default());
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Submits an object of `triangles` triangles bounded by `sphere`
+    /// under `mvp`: if the strip hides it, counts it in
+    /// [`Stats::submitted`] and [`Stats::culled_occlusion`] and returns
+    /// `Ok(false)` without calling `draw`; otherwise calls `draw` with the
+    /// renderer and returns `Ok(true)` (or `draw`'s error). `draw` must
+    /// submit only triangles inside `sphere` under `mvp` (any submission
+    /// method: clusters, normal masks, a cached mesh); `sphere: None`
+    /// draws and then reads the whole strip's hi-z again before the next
+    /// test.
+    pub fn submit_with<R>(
+        &mut self,
+        sphere: Option<&BoundingSphere>,
+        mvp: &Mat4,
+        triangles: u64,
+        draw: R,
+    ) -> Result<bool, Error>
+    where
+        R: FnOnce(&mut StripRenderer<'_, C, [W], S, N, F>) -> Result<(), Error>,
+    {
+        let config = self.renderer.stage.config;
+        let bound = sphere.and_then(|s| ScreenBound::of_sphere(s, mvp, &config));
+        if let Some(b) = &bound {
+            if self.hides(b) {
+                self.renderer.stats += Stats {
+                    submitted: triangles,
+                    culled_occlusion: triangles,
+                    ..Stats::default()
+                };
+                return Ok(false);
+            }
+        }
+        let result = draw(self.renderer);
+        self.touched(bound.as_ref());
+        result.map(|()| true)
+    }
+
+    /// [`Submit::submit_mesh_cached`] behind the occlusion test of the
+    /// mesh's bounding sphere ([`Mesh::bounds`]; a mesh without one is
+    /// always drawn). Returns whether it was drawn.
+    pub fn submit_mesh_cached<A: Attributes<N>>(
+        &mut self,
+        mesh: &Mesh<'_, A>,
+        mvp: &Mat4,
+        first_id: u32,
+        cache: &mut [ProcessedVertex],
+    ) -> Result<bool, Error> {
+        let n = mesh.indices.len() as u64;
+        self.submit_with(mesh.bounds.as_ref(), mvp, n, |r| {
+            r.submit_mesh_cached(mesh, mvp, first_id, cache)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn sphere(x: f32, y: f32, z: f32, r: f32) -> BoundingSphere {
+        BoundingSphere {
+            center: Vec3::new(x, y, z),
+            radius: r,
+        }
+    }
+
+    #[test]
+    fn tiles_round_up() {
+        assert_eq!(tiles_for(320, 16), 80);
+        assert_eq!(tiles_for(321, 17), 41 * 3);
+        assert_eq!(tiles_for(1, 1), 1);
+    }
+
+    #[test]
+    fn a_sphere_reaching_behind_the_eye_has_no_bound() {
+        let config = Config::new(64, 48);
+        let mvp = Mat4::perspective(1.0, 64.0 / 48.0, 0.1, 100.0);
+        assert!(ScreenBound::of_sphere(&sphere(0.0, 0.0, -5.0, 1.0), &mvp, &config).is_some());
+        assert!(ScreenBound::of_sphere(&sphere(0.0, 0.0, -0.5, 1.0), &mvp, &config).is_none());
+        assert!(ScreenBound::of_sphere(&sphere(0.0, 0.0, 3.0, 1.0), &mvp, &config).is_none());
+        for bad in [f32::NAN, f32::INFINITY, -1.0] {
+            assert!(ScreenBound::of_sphere(&sphere(0.0, 0.0, -5.0, bad), &mvp, &config).is_none());
+        }
+        for bad in [f32::NAN, f32::INFINITY] {
+            assert!(ScreenBound::of_sphere(&sphere(bad, 0.0, -5.0, 1.0), &mvp, &config).is_none());
+        }
+    }
+
+    #[test]
+    fn a_bound_holds_the_projected_sphere() {
+        let config = Config::new(64, 48);
+        let mvp = Mat4::perspective(1.0, 64.0 / 48.0, 0.1, 100.0);
+        let b = ScreenBound::of_sphere(&sphere(0.0, 0.0, -5.0, 1.0), &mvp, &config).unwrap();
+        assert!(b.x0 < 32 && b.x1 > 32 && b.y0 < 24 && b.y1 > 24);
+        assert!(b.x1 - b.x0 < 40, "{b:?}");
+        // The sphere's nearest point, z = -4, at window depth ...
+        let near = |d: f64| {
+            let (n, f) = (0.1f64, 100.0f64);
+            // OpenGL depth: z_ndc = (f + n) / (f - n) - 2 f n / ((f - n) d).
+            let ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * d);
+            ((ndc * 0.5 + 0.5) * 4_294_967_296.0) as u32
+        };
+        assert!(b.near <= near(4.0), "{} > {}", b.near, near(4.0));
+        assert!(b.near > near(3.9));
+    }
+}
