@@ -46,7 +46,7 @@
 use crate::color::PixelFormat;
 use crate::config::{Config, Error};
 use crate::depth::{DepthFunc, DepthWord};
-use crate::math::Mat4;
+use crate::math::{Mat4, Vec3};
 use crate::mesh::{BoundingSphere, Mesh, ProcessedVertex};
 use crate::pipeline::Submit;
 use crate::shade::{Attributes, FragmentShader};
@@ -76,6 +76,37 @@ const GAMMA: f64 = 16.0 / 16_777_216.0;
 /// The depth interpolation's margin, in `Z32` units: four `u16` LSBs.
 const Z_MARGIN: u32 = 1 << 18;
 
+/// An axis-aligned box in object space, `min` to `max` (each component
+/// `min <= max`): a tighter bound than a sphere for long or flat objects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// The smallest corner.
+    pub min: Vec3,
+    /// The largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The box from `min` to `max`.
+    pub const fn new(min: Vec3, max: Vec3) -> Aabb {
+        Aabb { min, max }
+    }
+
+    /// The smallest box holding `points` (`None` if empty or not finite).
+    pub fn from_points(points: &[Vec3]) -> Option<Aabb> {
+        let first = points.first()?;
+        let (mut lo, mut hi) = (*first, *first);
+        for p in points {
+            if !p.is_finite() {
+                return None;
+            }
+            lo = Vec3::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z));
+            hi = Vec3::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z));
+        }
+        Some(Aabb { min: lo, max: hi })
+    }
+}
+
 /// A conservative screen bound of an object: every pixel centre one of its
 /// triangles covers lies in columns `x0..x1` and rows `y0..y1` (clamped to
 /// the frame), and every depth it gets there is at least `near` (`Z32`).
@@ -98,17 +129,34 @@ impl ScreenBound {
     /// `config`'s size, or `None` where there is none: a sphere reaching
     /// behind the eye (or within rounding of it), or anything not finite.
     pub fn of_sphere(sphere: &BoundingSphere, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
-        let r = sphere.radius as f64;
-        let c = [
-            sphere.center.x as f64,
-            sphere.center.y as f64,
-            sphere.center.z as f64,
-        ];
-        if !(r >= 0.0 && r.is_finite() && c.iter().all(|v| v.is_finite()) && mvp.is_finite()) {
+        let r = sphere.radius;
+        let c = sphere.center;
+        if !(r >= 0.0 && r.is_finite()) {
+            return None;
+        }
+        let rv = Vec3::new(r, r, r);
+        ScreenBound::of_box(&Aabb::new(c - rv, c + rv), mvp, config)
+    }
+
+    /// The bound of everything the box holds under `mvp` in a frame of
+    /// `config`'s size, or `None` where there is none (as
+    /// [`ScreenBound::of_sphere`]).
+    pub fn of_box(aabb: &Aabb, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
+        let lo = [aabb.min.x as f64, aabb.min.y as f64, aabb.min.z as f64];
+        let hi = [aabb.max.x as f64, aabb.max.y as f64, aabb.max.z as f64];
+        if !(lo.iter().chain(&hi).all(|v| v.is_finite())
+            && (0..3).all(|k| lo[k] <= hi[k])
+            && mvp.is_finite())
+        {
             return None;
         }
         let m = mvp.rows();
-        let p_abs = [c[0].abs() + r, c[1].abs() + r, c[2].abs() + r, 1.0];
+        let p_abs = [
+            lo[0].abs().max(hi[0].abs()),
+            lo[1].abs().max(hi[1].abs()),
+            lo[2].abs().max(hi[2].abs()),
+            1.0,
+        ];
         let mag = |i: usize| -> f64 { (0..4).map(|j| (m[i][j] as f64).abs() * p_abs[j]).sum() };
         let err = [
             mag(0) * GAMMA,
@@ -116,16 +164,19 @@ impl ScreenBound {
             mag(2) * GAMMA,
             mag(3) * GAMMA,
         ];
+        let corner = (lo, hi);
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         let mut w_min = f64::INFINITY;
         for k in 0..8 {
-            let q = [
-                c[0] + if k & 1 == 0 { -r } else { r },
-                c[1] + if k & 2 == 0 { -r } else { r },
-                c[2] + if k & 4 == 0 { -r } else { r },
-                1.0,
-            ];
+            let pick = |axis: usize| {
+                if k >> axis & 1 == 0 {
+                    corner.0[axis]
+                } else {
+                    corner.1[axis]
+                }
+            };
+            let q = [pick(0), pick(1), pick(2), 1.0];
             let row = |i: usize| -> f64 { (0..4).map(|j| m[i][j] as f64 * q[j]).sum() };
             let w = row(3);
             w_min = w_min.min(w);
@@ -190,6 +241,12 @@ impl ScreenBound {
     }
 }
 
+/// What [`Occluder::test`] found: skip (counted), or draw with this bound.
+enum Test {
+    Skipped,
+    Draw(Option<ScreenBound>),
+}
+
 /// A [`StripRenderer`] with hi-z tiles: submits objects, skipping those
 /// hidden behind what the strip holds (see the [module](self)). Made by
 /// [`StripRenderer::occluder`].
@@ -198,6 +255,8 @@ pub struct Occluder<'r, 'b, C, W, const S: u32, const N: usize, F> {
     tiles: &'r mut [HiZTile],
     /// Tile columns.
     cols: u32,
+    /// Whether the hi-z test runs (see [`Occluder::set_hiding`]).
+    hiding: bool,
 }
 
 impl<C, W, const S: u32, const N: usize, F> core::fmt::Debug for Occluder<'_, '_, C, W, S, N, F> {
@@ -235,6 +294,7 @@ impl<'b, C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: Fragment
             renderer: self,
             tiles,
             cols: w.div_ceil(HIZ_TILE),
+            hiding: true,
         })
     }
 }
@@ -245,6 +305,14 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
     /// The renderer's counters so far.
     pub fn stats(&self) -> Stats {
         self.renderer.stats()
+    }
+
+    /// Turns the hi-z test off (or on again; it is on by default). Off,
+    /// the occluder still skips objects whose bounds lie outside the
+    /// frustum or miss the strip: the baseline occlusion culling is
+    /// measured against, so that the difference is the hi-z test's alone.
+    pub fn set_hiding(&mut self, on: bool) {
+        self.hiding = on;
     }
 
     /// The tiles `bound` touches in this strip, as tile columns and rows
@@ -328,9 +396,11 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
     }
 
     /// Submits an object of `triangles` triangles bounded by `sphere`
-    /// under `mvp`: if the strip hides it, counts it in
-    /// [`Stats::submitted`] and [`Stats::culled_occlusion`] and returns
-    /// `Ok(false)` without calling `draw`; otherwise calls `draw` with the
+    /// under `mvp`. It is skipped, counted in [`Stats::submitted`] and
+    /// returning `Ok(false)` without calling `draw`, if the sphere lies
+    /// outside the frustum ([`Stats::culled_object`]), if its bound misses
+    /// the strip's pixels ([`Stats::outside_strip`]), or if the strip
+    /// hides it ([`Stats::culled_occlusion`]). Otherwise it calls `draw` with the
     /// renderer and returns `Ok(true)` (or `draw`'s error). `draw` must
     /// submit only triangles inside `sphere` under `mvp` (any submission
     /// method: clusters, normal masks, a cached mesh); `sphere: None`
@@ -346,21 +416,88 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
     where
         R: FnOnce(&mut StripRenderer<'_, C, [W], S, N, F>) -> Result<(), Error>,
     {
-        let config = self.renderer.stage.config;
-        let bound = sphere.and_then(|s| ScreenBound::of_sphere(s, mvp, &config));
-        if let Some(b) = &bound {
-            if self.hides(b) {
-                self.renderer.stats += Stats {
-                    submitted: triangles,
-                    culled_occlusion: triangles,
-                    ..Stats::default()
-                };
-                return Ok(false);
-            }
-        }
+        self.submit_bounded(sphere, None, mvp, triangles, draw)
+    }
+
+    /// [`Occluder::submit_with`] with a box as well as (or instead of) the
+    /// sphere: the box, tighter for most objects, gives the screen bound;
+    /// the sphere, if any, the frustum test. `draw` must submit only
+    /// triangles inside both.
+    pub fn submit_bounded<R>(
+        &mut self,
+        sphere: Option<&BoundingSphere>,
+        aabb: Option<&Aabb>,
+        mvp: &Mat4,
+        triangles: u64,
+        draw: R,
+    ) -> Result<bool, Error>
+    where
+        R: FnOnce(&mut StripRenderer<'_, C, [W], S, N, F>) -> Result<(), Error>,
+    {
+        let bound = match self.test(sphere, aabb, mvp, triangles) {
+            Test::Skipped => return Ok(false),
+            Test::Draw(b) => b,
+        };
         let result = draw(self.renderer);
         self.touched(bound.as_ref());
         result.map(|()| true)
+    }
+
+    /// Whether an object of `triangles` triangles bounded by `sphere` and
+    /// `aabb` under `mvp` is skipped, as [`Occluder::submit_bounded`]
+    /// would skip it (and counted so), without drawing anything. For
+    /// objects split into parts with bounds of their own: the object is
+    /// tested whole first, then each part is submitted.
+    pub fn skips(
+        &mut self,
+        sphere: Option<&BoundingSphere>,
+        aabb: Option<&Aabb>,
+        mvp: &Mat4,
+        triangles: u64,
+    ) -> bool {
+        matches!(self.test(sphere, aabb, mvp, triangles), Test::Skipped)
+    }
+
+    fn test(
+        &mut self,
+        sphere: Option<&BoundingSphere>,
+        aabb: Option<&Aabb>,
+        mvp: &Mat4,
+        triangles: u64,
+    ) -> Test {
+        let config = self.renderer.stage.config;
+        let skip = |stats: Stats| Stats {
+            submitted: triangles,
+            ..stats
+        };
+        if sphere.is_some_and(|s| s.outside_frustum(mvp)) {
+            self.renderer.stats += skip(Stats {
+                culled_object: triangles,
+                ..Stats::default()
+            });
+            return Test::Skipped;
+        }
+        let bound = match aabb {
+            Some(b) => ScreenBound::of_box(b, mvp, &config),
+            None => sphere.and_then(|s| ScreenBound::of_sphere(s, mvp, &config)),
+        };
+        if let Some(b) = &bound {
+            if self.tile_range(b).is_none() {
+                self.renderer.stats += skip(Stats {
+                    outside_strip: triangles,
+                    ..Stats::default()
+                });
+                return Test::Skipped;
+            }
+            if self.hiding && self.hides(b) {
+                self.renderer.stats += skip(Stats {
+                    culled_occlusion: triangles,
+                    ..Stats::default()
+                });
+                return Test::Skipped;
+            }
+        }
+        Test::Draw(bound)
     }
 
     /// [`Submit::submit_mesh_cached`] behind the occlusion test of the
@@ -383,7 +520,6 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
 
     fn sphere(x: f32, y: f32, z: f32, r: f32) -> BoundingSphere {
         BoundingSphere {

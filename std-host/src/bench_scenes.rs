@@ -12,6 +12,7 @@
 //! | `bunny` | the Stanford bunny (69,451 triangles), Gouraud (head-light Lambert on vertex normals) | 1920x1080 |
 //! | `bunny-subdiv` | the bunny with every triangle split 1→4 at its edge midpoints, twice (1,111,216 triangles) | 1920x1080 |
 //! | `quad` | two flat triangles covering the whole frame at depth 0.5 | 1920x1080 |
+//! | `spots` | a 10x10 grid of Spot (5,856 triangles each, 585,600 in all), Gouraud, seen from eye height outside the grid, drawn front to back (the occlusion-culling scene, `docs/culling.md`) | 320x240 |
 //!
 //! The sphere has exactly `2 * stacks * slices` triangles like tgx's: each
 //! (stack, slice) cell is a quad split into two triangles, including the
@@ -31,7 +32,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 /// Names of the built-in scenes.
-pub const NAMES: [&str; 5] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad"];
+pub const NAMES: [&str; 6] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad", "spots"];
 
 /// The bunny mesh shipped in the repository.
 pub const BUNNY_OBJ: &str = concat!(
@@ -133,6 +134,7 @@ pub fn default_size(name: &str) -> (u32, u32) {
     match name {
         "cubes" => (800, 600),
         "sphere" => (240, 320),
+        "spots" => (320, 240),
         _ => (1920, 1080),
     }
 }
@@ -148,6 +150,7 @@ pub fn builtin(name: &str, view: &View) -> Result<BenchScene, String> {
         }
         "bunny" => (bunny_scene(view, 0)?, None),
         "bunny-subdiv" => (bunny_scene(view, 2)?, None),
+        "spots" => (spots_scene(view)?, None),
         "quad" if view.has_camera() => return Err(NO_CAMERA_QUAD.to_string()),
         "quad" => (quad_scene(), None),
         other => {
@@ -247,6 +250,8 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spi
             mvp: Mat4::IDENTITY,
             clusters: None,
             normal_classes: None,
+            aabb: None,
+            parts: None,
         }],
         clip_tris: Vec::new(),
     };
@@ -378,6 +383,8 @@ pub fn quad_scene() -> Scene {
             mvp: Mat4::IDENTITY,
             clusters: None,
             normal_classes: None,
+            aabb: None,
+            parts: None,
         }],
         clip_tris: Vec::new(),
     }
@@ -403,6 +410,7 @@ mod tests {
             ids: false,
             mode: microraster::RasterMode::Clipping,
             inv_w: false,
+            occlusion: crate::render::Occlusion::Off,
         }
     }
 
@@ -565,4 +573,154 @@ mod tests {
         let b = builtin("bunny-subdiv", &View::new(192, 108)).unwrap();
         assert_eq!(b.scene.triangle_count(), 1_111_216);
     }
+}
+
+/// Spot shipped in the repository.
+pub const SPOT_OBJ: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/models/spot.obj");
+
+/// Spots a side of the `spots` scene's grid.
+pub const SPOTS_GRID: usize = 10;
+
+/// The grid's spacing between Spots' centres (Spot is 0.94 wide and 1.72
+/// long, 1.69 high).
+pub const SPOTS_SPACING: f32 = 2.0;
+
+/// The camera's height above the grid's floor level (Spot's feet at
+/// y = -0.74, its back at about 0.5, its head at 0.95): a grown-up's eye
+/// among cows.
+pub const SPOTS_EYE_Y: f32 = 0.45;
+
+/// Camera `k` of `count` on a circle around the grid's centre, at eye
+/// height, outside the grid by one spacing, looking at the centre: eye and
+/// target.
+pub fn spots_camera(k: usize, count: usize, n: usize) -> ([f32; 3], [f32; 3]) {
+    let half = (n as f32 - 1.0) * 0.5 * SPOTS_SPACING;
+    let radius = half * std::f32::consts::SQRT_2 * 0.75 + SPOTS_SPACING;
+    let a = std::f32::consts::TAU * (k as f32 + 0.5) / count.max(1) as f32;
+    (
+        [radius * a.cos(), SPOTS_EYE_Y, radius * a.sin()],
+        [0.0, 0.1, 0.0],
+    )
+}
+
+/// Spot's mesh, centred on the grid's cells and coloured per vertex (a
+/// fixed light, Lambert) in each instance's own tint.
+#[derive(Clone, Debug)]
+pub struct SpotGrid {
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    shade: Vec<f32>,
+    bounds: Option<BoundingSphere>,
+    aabb: Option<microraster::occlusion::Aabb>,
+    parts: std::sync::Arc<Vec<crate::occlusion::Part>>,
+}
+
+impl SpotGrid {
+    /// Loads Spot.
+    pub fn load() -> Result<SpotGrid, String> {
+        let mesh = obj::load_obj(Path::new(SPOT_OBJ))?;
+        let positions: Vec<Vec3> = mesh
+            .positions
+            .iter()
+            .map(|&p| Vec3::from_array(p))
+            .collect();
+        let light = Vec3::new(0.4, 0.8, 0.45).normalize();
+        let (indices, parts) =
+            crate::occlusion::split(&positions, &mesh.indices, crate::occlusion::PART_TRIANGLES);
+        let shade = vertex_normals(&positions, &indices)
+            .iter()
+            .map(|n| 0.2 + 0.8 * n.dot(light).max(0.0))
+            .collect();
+        Ok(SpotGrid {
+            bounds: BoundingSphere::from_points(&positions),
+            aabb: microraster::occlusion::Aabb::from_points(&positions),
+            positions,
+            indices,
+            shade,
+            parts: std::sync::Arc::new(parts),
+        })
+    }
+
+    /// `n x n` Spots seen from `eye` towards `target` (`fov` degrees,
+    /// `aspect`), drawn front to back: sorted by the distance from the eye
+    /// to each bounding sphere's centre.
+    pub fn scene(
+        &self,
+        n: usize,
+        eye: [f32; 3],
+        target: [f32; 3],
+        fov: f32,
+        aspect: f32,
+        inv_w: bool,
+    ) -> Result<Scene, String> {
+        let extent = n as f32 * SPOTS_SPACING * 2.0 + 10.0;
+        let proj = scene::projection(inv_w, microraster::math::radians(fov), aspect, 0.05, extent);
+        let view_proj = proj * scene::look_at(eye, target)?;
+        let spacing = SPOTS_SPACING;
+        let half = (n as f32 - 1.0) * 0.5 * spacing;
+        let mut objects = Vec::with_capacity(n * n);
+        let mut order = Vec::with_capacity(n * n);
+        for i in 0..n {
+            for j in 0..n {
+                let k = (i * n + j) as u32;
+                let h = k.wrapping_mul(2_654_435_761);
+                let yaw = (h >> 8) as f32 / 16_777_216.0 * std::f32::consts::TAU;
+                let (x, z) = (i as f32 * spacing - half, j as f32 * spacing - half);
+                let model = Mat4::translation(Vec3::new(x, 0.0, z)) * Mat4::rotation_y(yaw);
+                let tint = [
+                    150.0 + (h >> 24 & 63) as f32 * 1.5,
+                    150.0 + (h >> 16 & 63) as f32 * 1.5,
+                    150.0 + (h >> 10 & 63) as f32 * 1.5,
+                ];
+                let colors = self
+                    .shade
+                    .iter()
+                    .map(|s| {
+                        Rgb888::new(
+                            (s * tint[0]) as u8,
+                            (s * tint[1]) as u8,
+                            (s * tint[2]) as u8,
+                        )
+                    })
+                    .collect();
+                let c = self.bounds.map_or(Vec3::new(0.0, 0.0, 0.0), |b| b.center);
+                let world = model.transform_point(c);
+                let d = [world.x - eye[0], world.y - eye[1], world.z - eye[2]];
+                order.push(d.iter().map(|v| v * v).sum::<f32>());
+                objects.push(Object {
+                    positions: self.positions.clone(),
+                    indices: self.indices.clone(),
+                    colors: ObjectColors::PerVertex(colors),
+                    bounds: self.bounds,
+                    mvp: view_proj * model,
+                    clusters: None,
+                    normal_classes: None,
+                    aabb: self.aabb,
+                    parts: Some(self.parts.clone()),
+                });
+            }
+        }
+        let mut idx: Vec<usize> = (0..objects.len()).collect();
+        idx.sort_by(|&a, &b| order[a].total_cmp(&order[b]));
+        let mut slots: Vec<Option<Object>> = objects.into_iter().map(Some).collect();
+        let objects = idx.into_iter().filter_map(|i| slots[i].take()).collect();
+        Ok(Scene {
+            objects,
+            clip_tris: Vec::new(),
+        })
+    }
+}
+
+/// The `spots` scene: [`SPOTS_GRID`]² Spots from camera 0 of
+/// [`spots_camera`] (or as `view` says), 60° vertical field of view.
+pub fn spots_scene(view: &View) -> Result<Scene, String> {
+    let (e, t) = spots_camera(0, 64, SPOTS_GRID);
+    SpotGrid::load()?.scene(
+        SPOTS_GRID,
+        view.eye.unwrap_or(e),
+        view.target.unwrap_or(t),
+        view.fov.unwrap_or(60.0),
+        view.aspect(),
+        view.inv_w,
+    )
 }

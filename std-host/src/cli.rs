@@ -26,7 +26,7 @@ use crate::image_out::{image_format, MAX_DIMENSION};
 
 /// Names accepted by `--scene`.
 /// (`crate::bench_scenes` builds them; see there for what each one is.)
-pub const SCENES: [&str; 5] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad"];
+pub const SCENES: [&str; 6] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad", "spots"];
 
 /// The scenes of `report speed-vs-error`, in order.
 pub const REPORT_SCENES: [&str; 5] = ["cubes", "spot", "teapot", "bunny", "layers"];
@@ -73,6 +73,8 @@ Which options each source uses:
   --obj FILE            --eye, --target, --fov (default: framed to fit from +z, 60°), and
                         --shading, --light, --texture, --no-texture, --texture-filter (default: lit
                         per pixel by a key light, the .mtl colours and texture)
+  --scene spots         --eye, --target, --fov (default: eye height outside the 10x10 grid, 60°);
+                        objects front to back for that camera
   --scene quad          no camera: clip-space triangles; --eye, --target, --fov are refused
   --clip-tris FILE      no camera: clip-space triangles; --eye, --target, --fov are refused
 Every source uses --size, --threads, --strip-rows, --cull, --depth, --subpixel and the
@@ -259,6 +261,14 @@ pub struct RenderArgs {
           value_parser = clap::value_parser!(u8).range(1..=16))]
     pub normal_masks: Option<u8>,
 
+    /// Occlusion culling (see docs/culling.md): strips drawn at once, each
+    /// object tested against the strip's max depth per 8x8 tile before its
+    /// vertices are transformed. The image is the same; objects drawn
+    /// front to back hide the most (the spots scene is). Needs a depth
+    /// buffer and --mode clipping.
+    #[arg(long)]
+    pub occlusion: bool,
+
     /// Detail culling (lossy; 0: off): drop objects, and with
     /// --cull-clusters clusters, whose projection is provably less than PX
     /// pixels across, before transform.
@@ -440,7 +450,8 @@ pub struct BenchArgs {
     /// Built-in scene: cubes (800x600), sphere (tgx's 20,000-triangle
     /// sphere, 240x320, 1 thread, u16 depth, RGB565), bunny (69,451
     /// triangles, 1920x1080), bunny-subdiv (1,111,216 triangles, 1920x1080),
-    /// quad (two triangles, 1920x1080, with the memory floor).
+    /// quad (two triangles, 1920x1080, with the memory floor), spots (a
+    /// 10x10 grid of Spot, 585,600 triangles, 320x240).
     #[arg(
         long,
         value_name = "NAME",
@@ -558,6 +569,15 @@ pub struct BenchArgs {
     /// RGB8 output included), next to the buffer-reusing loop.
     #[arg(long)]
     pub render_fn: bool,
+
+    /// Occlusion culling (see docs/culling.md): also time `render::render`
+    /// drawing strips at once with every object tested against its strip's
+    /// hi-z before transform, interleaved frame by frame with the same
+    /// strips without the test (implies --render-fn); the JSON's
+    /// `render_fn.occlusion` gives both medians, the ratio, the triangles
+    /// culled and whether the images match the plain one.
+    #[arg(long)]
+    pub occlusion: bool,
 
     /// Write the last frame of the first run to this image (.png or .ppm).
     #[arg(long, value_name = "FILE", value_parser = parse_image_path)]
@@ -872,6 +892,25 @@ pub struct CullArgs {
         default_value = "240,60,16"
     )]
     pub sector_rows: Vec<u32>,
+
+    /// Measure occlusion culling instead, on the spots scene (a grid of
+    /// Spots; the models and cluster options are ignored): the table of
+    /// docs/culling.md's "Occlusion culling".
+    #[arg(long)]
+    pub occlusion: bool,
+
+    /// Spots a side of the occlusion scene's grid.
+    #[arg(long, value_name = "N", default_value = "10")]
+    pub grid: usize,
+
+    /// Strip heights for the occlusion table.
+    #[arg(
+        long,
+        value_name = "ROWS,..",
+        value_delimiter = ',',
+        default_value = "240,16"
+    )]
+    pub occlusion_rows: Vec<u32>,
 
     /// Also write the measurements as JSON.
     #[arg(long, value_name = "FILE")]

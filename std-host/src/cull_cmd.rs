@@ -159,6 +159,28 @@ pub struct MaskReport {
 
 /// Runs the command.
 pub fn run(args: &CullArgs) -> Result<(), String> {
+    if args.occlusion {
+        let rows = crate::occlusion::measure(
+            args.grid,
+            args.cameras,
+            args.size,
+            &args.occlusion_rows,
+            args.rounds,
+        )?;
+        if let Some(path) = &args.json {
+            let text = serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?;
+            crate::output::write_all(&[crate::output::Output {
+                option: "--json",
+                path,
+                payload: crate::output::Payload::Raw(text.as_bytes()),
+            }])?;
+        }
+        print!(
+            "{}",
+            crate::occlusion::markdown(&rows, args.grid, args.cameras, args.size)
+        );
+        return Ok(());
+    }
     let opts = ClusterOptions {
         max_vertices: args.max_vertices,
         max_triangles: args.max_triangles,

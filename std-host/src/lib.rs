@@ -37,6 +37,7 @@ pub mod normal_mask;
 pub mod cull_cmd;
 pub mod image_out;
 pub mod obj;
+pub mod occlusion;
 pub mod output;
 pub mod pipeline;
 pub mod render;

@@ -16,6 +16,7 @@ use crate::pipeline::{
     draw_layers, draw_layers_cleared, fill, for_each_tile, FramePipeline, Layer,
 };
 use crate::scene::Scene;
+use microraster::occlusion::{tiles_for, HiZTile, Occluder};
 use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::prelude::{DepthWord, Submit};
 use microraster::{
@@ -23,6 +24,7 @@ use microraster::{
     Stats, StripRenderer, TriangleId,
 };
 use serde::Serialize;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The background colour of rendered images.
@@ -70,6 +72,28 @@ pub struct RenderOptions {
     /// 1/w depth (the scene built with `View::inv_w`): depth test
     /// `Greater`, depth cleared to 0 instead of the far plane.
     pub inv_w: bool,
+    /// Occlusion culling ([`microraster::occlusion`]).
+    pub occlusion: Occlusion,
+}
+
+/// Whether to cull by occlusion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Occlusion {
+    /// No: set up into frames, binned, drawn strip by strip.
+    #[default]
+    Off,
+    /// Strips drawn at once by strip renderers (each strip submits the
+    /// scene), the vertex stage once per object by the first strip that
+    /// draws it, objects and their parts skipped where their bounds miss
+    /// the strip, but without the hi-z test
+    /// ([`Occluder::set_hiding`]): what `On` is measured against.
+    Strips,
+    /// As `Strips`, each object (and each part of it, see
+    /// [`crate::scene::Object::parts`]) tested against the strip's hi-z
+    /// before its vertices are transformed. The image is the same; it
+    /// hides the most with objects in front-to-back order. Needs a depth
+    /// buffer and the clipping mode.
+    On,
 }
 
 /// The depth image of a render.
@@ -128,6 +152,9 @@ pub struct Counters {
     /// Skipped before transform by the frame's normal mask
     /// (`--normal-masks`).
     pub culled_mask: u64,
+    /// Skipped before transform, hidden behind the strip's hi-z
+    /// (`--occlusion`; counted once per strip the object reaches).
+    pub culled_occlusion: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -146,6 +173,7 @@ impl From<&Stats> for Counters {
             culled_hierarchy: s.culled_hierarchy,
             culled_detail: s.culled_detail,
             culled_mask: s.culled_mask,
+            culled_occlusion: s.culled_occlusion,
         }
     }
 }
@@ -209,8 +237,8 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
 }
 
 fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
-    if opts.mode == RasterMode::Clipless {
-        return render_clipless::<S>(scene, opts);
+    if opts.mode == RasterMode::Clipless || opts.occlusion != Occlusion::Off {
+        return render_immediate::<S>(scene, opts);
     }
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
@@ -265,12 +293,25 @@ fn render_s<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendere
 /// [`StripRenderer`](microraster::StripRenderer), from vertices processed
 /// once per frame. The counters are summed over the strips (each one sets
 /// up the triangles that reach it).
-fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
+/// Strips (or tiles) drawn at once by strip renderers: the clipless mode,
+/// and occlusion culling ([`RenderOptions::occlusion`]).
+fn render_immediate<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<Rendered, String> {
     let (w, h) = (opts.width, opts.height);
     let mut config = Config::new(w, h);
     config.cull = opts.cull;
     config.detail = opts.detail;
-    config.mode = RasterMode::Clipless;
+    let occlusion = opts.occlusion != Occlusion::Off;
+    let hiz = opts.occlusion == Occlusion::On;
+    if occlusion {
+        if opts.mode == RasterMode::Clipless {
+            return Err("occlusion culling is built for the clipping mode only".to_string());
+        }
+        if opts.depth == DepthKind::None {
+            return Err("occlusion culling needs a depth buffer".to_string());
+        }
+    } else {
+        config.mode = RasterMode::Clipless;
+    }
     if opts.inv_w {
         config.depth_func = DepthFunc::Greater;
     }
@@ -279,24 +320,24 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
     let len = w as usize * h as usize;
     let t0 = Instant::now();
     // The vertex stage, once per object (it depends on the configuration
-    // only), through a one-row renderer that draws nothing.
-    let caches: Vec<Vec<ProcessedVertex>> = {
+    // only), through a one-row renderer that draws nothing: all at once for
+    // the clipless mode, and under occlusion culling by the first strip
+    // that draws the object.
+    let caches: Vec<OnceLock<Vec<ProcessedVertex>>> =
+        scene.objects.iter().map(|_| OnceLock::new()).collect();
+    if !occlusion {
         let mut row = vec![TriangleId(0); w as usize];
         let mut none = NoDepth;
         let probe = StripRenderer::<_, _, S>::with_subpixel_bits(config, 0, 1, &mut row, &mut none)
             .map_err(|e| e.to_string())?;
-        scene
-            .objects
-            .iter()
-            .map(|o| {
-                let mut c = vec![ProcessedVertex::EMPTY; o.positions.len()];
-                Submit::<S>::process_vertices(&probe, &o.mvp, &o.positions, &mut c);
-                c
-            })
-            .collect()
-    };
+        for (o, cache) in scene.objects.iter().zip(&caches) {
+            let mut c = vec![ProcessedVertex::EMPTY; o.positions.len()];
+            Submit::<S>::process_vertices(&probe, &o.mvp, &o.positions, &mut c);
+            let _ = cache.set(c);
+        }
+    }
     let cache_refs: Vec<Option<&[ProcessedVertex]>> =
-        caches.iter().map(|c| Some(c.as_slice())).collect();
+        caches.iter().map(|c| c.get().map(Vec::as_slice)).collect();
     let pieces = crate::pipeline::partition(scene, 1).concat();
     let setup_ms = t0.elapsed().as_secs_f64() * 1e3;
     let stats = std::sync::Mutex::new(Stats::default());
@@ -317,7 +358,16 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
                                 DepthWord::FAR
                             });
                             let mut r = StripRenderer::<_, _, S>::with_rect(config, rect, c, d)?;
-                            fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                            if occlusion {
+                                let [x0, x1, y0, y1] = rect;
+                                let mut tiles =
+                                    vec![HiZTile::default(); tiles_for(x1 - x0, y1 - y0)];
+                                let mut o = r.occluder(&mut tiles)?;
+                                o.set_hiding(hiz);
+                                fill_occluded::<S, _, _>(&mut o, scene, &caches)?;
+                            } else {
+                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                            }
                             (r.render_stats().pixels_written, r.stats())
                         }
                         None => {
@@ -402,6 +452,109 @@ fn render_clipless<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result<
     })
 }
 
+/// Draws object `ob` (triangles `range` of it) whose first triangle id is
+/// `first` into `r`: clusters and normal masks with their own scratch
+/// cache, as in [`fill`], else through `cache`, filled by the first strip
+/// that needs it.
+fn draw_object<const S: u32, C: PixelFormat, W: DepthWord>(
+    r: &mut StripRenderer<'_, C, [W], S>,
+    ob: &crate::scene::Object,
+    range: std::ops::Range<usize>,
+    first: u32,
+    cache: &OnceLock<Vec<ProcessedVertex>>,
+) -> Result<(), microraster::Error> {
+    let scratch = || vec![ProcessedVertex::EMPTY; ob.positions.len()];
+    let whole = ob.mesh();
+    if let Some(c) = &ob.clusters {
+        return r.submit_clusters(&whole, &ob.mvp, &c.set(), c.cull, first, &mut scratch());
+    }
+    if let Some(c) = &ob.normal_classes {
+        return r.submit_masked(&whole, &ob.mvp, &c.set(), first, &mut scratch());
+    }
+    let cache = cache.get_or_init(|| {
+        let mut c = scratch();
+        Submit::<S>::process_vertices(r, &ob.mvp, &ob.positions, &mut c);
+        c
+    });
+    let mut mesh = whole;
+    mesh.indices = ob.indices.get(range.clone()).unwrap_or(&[]);
+    if let crate::scene::ObjectColors::PerTriangle(c) = &ob.colors {
+        mesh.attributes = microraster::MeshColors::PerTriangle(c.get(range.clone()).unwrap_or(&[]));
+    }
+    r.submit_processed_mesh(&mesh, first.wrapping_add(range.start as u32), cache)
+}
+
+/// The clip-space triangles of `scene`, ids from `first`.
+fn draw_clip_tris<const S: u32, C: PixelFormat, W: DepthWord>(
+    r: &mut StripRenderer<'_, C, [W], S>,
+    scene: &Scene,
+    first: u32,
+) -> Result<(), microraster::Error> {
+    for (k, t) in scene.clip_tris.iter().enumerate() {
+        let [cr, cg, cb] = t.color.unwrap_or([255, 255, 255]);
+        let color = [cr as f32, cg as f32, cb as f32];
+        let v = t.v.map(|p| microraster::ClipVertex {
+            pos: microraster::Vec4::from_array(p),
+            varyings: color,
+        });
+        r.submit_triangle(v, first.wrapping_add(k as u32))?;
+    }
+    Ok(())
+}
+
+/// Submits `scene` through an occluder in drawing order: each object
+/// behind its bounds' occlusion test, and an object split into parts
+/// ([`crate::scene::Object::parts`]) tested whole and then part by part;
+/// the clip-space triangles without a bound. Triangle ids as in [`fill`].
+fn fill_occluded<const S: u32, C: PixelFormat, W: DepthWord>(
+    o: &mut Occluder<'_, '_, C, W, S, 3, microraster::VertexColor>,
+    scene: &Scene,
+    caches: &[OnceLock<Vec<ProcessedVertex>>],
+) -> Result<(), microraster::Error> {
+    let mut id = 0u32;
+    for (ob, cache) in scene.objects.iter().zip(caches) {
+        let first = id;
+        let n = ob.indices.len();
+        id = id.wrapping_add(n as u32);
+        let (sphere, aabb) = (ob.bounds.as_ref(), ob.aabb.as_ref());
+        match &ob.parts {
+            Some(parts) if ob.clusters.is_none() && ob.normal_classes.is_none() => {
+                if o.skips(sphere, aabb, &ob.mvp, n as u64) {
+                    continue;
+                }
+                for p in parts.iter() {
+                    let range = p.triangles.clone();
+                    let len = range.len() as u64;
+                    o.submit_bounded(None, Some(&p.aabb), &ob.mvp, len, |r| {
+                        draw_object(r, ob, range, first, cache)
+                    })?;
+                }
+                // What no part holds (triangles without a box), unbounded.
+                let rest = parts.last().map_or(0, |p| p.triangles.end).min(n)..n;
+                if !rest.is_empty() {
+                    let len = rest.len() as u64;
+                    o.submit_with(None, &ob.mvp, len, |r| {
+                        draw_object(r, ob, rest, first, cache)
+                    })?;
+                }
+            }
+            _ => {
+                o.submit_bounded(sphere, aabb, &ob.mvp, n as u64, |r| {
+                    draw_object(r, ob, 0..n, first, cache)
+                })?;
+            }
+        }
+    }
+    if scene.clip_tris.is_empty() {
+        return Ok(());
+    }
+    let n = scene.clip_tris.len() as u64;
+    o.submit_with(None, &microraster::Mat4::IDENTITY, n, |r| {
+        draw_clip_tris(r, scene, id)
+    })?;
+    Ok(())
+}
+
 /// Draws the binned frames `layers` into `color` with a new depth buffer
 /// `kind`, every strip cleared to `clear` first. Returns the depth buffer
 /// after drawing and the pixels written.
@@ -463,6 +616,7 @@ mod tests {
             ids: true,
             mode: RasterMode::Clipping,
             inv_w: false,
+            occlusion: Occlusion::Off,
         }
     }
 

@@ -322,6 +322,10 @@ fn nonzero(c: &Counters) -> String {
             c.culled_detail,
         ),
         ("back-facing normal class (before transform)", c.culled_mask),
+        (
+            "hidden behind the strip's hi-z (before transform, per strip)",
+            c.culled_occlusion,
+        ),
         ("degenerate", c.culled_degenerate),
         ("non-finite", c.rejected_nonfinite),
         ("index out of range", c.rejected_index),
@@ -392,6 +396,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             crate::cli::ModeArg::Clipless => microraster::RasterMode::Clipless,
         },
         inv_w: args.depth_kind == crate::cli::DepthKindArg::InvW,
+        occlusion: if args.occlusion {
+            crate::render::Occlusion::On
+        } else {
+            crate::render::Occlusion::Off
+        },
     };
     if opts.inv_w {
         if args.depth == DepthArg::None {

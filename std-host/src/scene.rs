@@ -37,6 +37,14 @@ pub struct Object {
     /// Normal masks (see [`crate::normal_mask::mask_scene`]); not with
     /// `clusters`.
     pub normal_classes: Option<std::sync::Arc<crate::normal_mask::NormalClassData>>,
+    /// An object-space box around the positions: occlusion culling's bound
+    /// when given (tighter than the sphere), else the sphere's.
+    pub aabb: Option<microraster::occlusion::Aabb>,
+    /// Occlusion culling's parts: consecutive runs of triangles from the
+    /// first, each with its own box (see [`crate::occlusion::split`]);
+    /// tested after the whole object. Triangles after the last part are
+    /// drawn without a test.
+    pub parts: Option<std::sync::Arc<Vec<crate::occlusion::Part>>>,
 }
 
 /// The clusters of an [`Object`] and how they are tested.
@@ -222,6 +230,8 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
             mvp: view_proj * cubes::model_matrix(ops),
             clusters: None,
             normal_classes: None,
+            aabb: None,
+            parts: None,
         })
         .collect();
     Ok(Scene {
@@ -280,6 +290,8 @@ pub fn mesh_scene(
             mvp: proj * view,
             clusters: None,
             normal_classes: None,
+            aabb: None,
+            parts: None,
         }],
         clip_tris: Vec::new(),
     })

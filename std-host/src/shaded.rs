@@ -646,6 +646,7 @@ mod tests {
             ids: true,
             mode: microraster::RasterMode::Clipping,
             inv_w: false,
+            occlusion: crate::render::Occlusion::Off,
         }
     }
 

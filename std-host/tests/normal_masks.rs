@@ -302,6 +302,7 @@ fn a_masked_scene_renders_the_same_image_on_threads() {
         ids: true,
         mode: microraster::RasterMode::Clipping,
         inv_w: false,
+        occlusion: microraster_host::render::Occlusion::Off,
     };
     let want = render(&plain, &ro(1)).unwrap();
     for threads in [1, 2, 3] {

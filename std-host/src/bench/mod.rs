@@ -109,6 +109,9 @@ pub struct Settings {
     pub split: bool,
     /// Also time `render::render`.
     pub render_fn: bool,
+    /// Also time `render::render` with occlusion culling, interleaved with
+    /// the plain one (implies `render_fn`).
+    pub occlusion: bool,
 }
 
 /// Resolves the options against the scene `name` (`None` for `--obj`).
@@ -153,7 +156,8 @@ pub fn settings(args: &BenchArgs, name: Option<&str>) -> Settings {
         peers: args.peers,
         floor: args.floor || name == Some("quad"),
         split: !args.no_split,
-        render_fn: args.render_fn,
+        render_fn: args.render_fn || args.occlusion,
+        occlusion: args.occlusion,
     }
 }
 
@@ -590,6 +594,7 @@ mod tests {
                 ids: false,
                 mode: microraster::RasterMode::Clipping,
                 inv_w: false,
+                occlusion: crate::render::Occlusion::Off,
             };
             let want = render::render(&bs.scene, &opts).unwrap();
             let sum = format!("\"checksum\":\"{:016x}\"", want.checksum());

@@ -487,6 +487,7 @@ mod tests {
             ids: false,
             mode: microraster::RasterMode::Clipping,
             inv_w: false,
+            occlusion: crate::render::Occlusion::Off,
         }
     }
 

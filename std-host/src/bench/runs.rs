@@ -361,9 +361,20 @@ fn render_fn_section(
         ids: false,
         mode: microraster::RasterMode::Clipping,
         inv_w: false,
+        occlusion: crate::render::Occlusion::Off,
+    };
+    let occluded = RenderOptions {
+        occlusion: crate::render::Occlusion::On,
+        ..opts
     };
     let (mut total, mut setup, mut raster) = (Vec::new(), Vec::new(), Vec::new());
+    let strips = RenderOptions {
+        occlusion: crate::render::Occlusion::Strips,
+        ..opts
+    };
+    let (mut occ_total, mut strips_total) = (Vec::new(), Vec::new());
     let mut checksum = 0;
+    let (mut identical, mut occ_stats) = (true, None);
     for k in 0..s.warmup + s.frames {
         progress.tick("render_fn", k, s.warmup + s.frames);
         bs.set_frame(k);
@@ -376,6 +387,20 @@ fn render_fn_section(
             raster.push(r.timings.raster_ms);
         }
         checksum = r.checksum();
+        if s.occlusion {
+            // Interleaved: strips without, strips with occlusion culling.
+            let t = Instant::now();
+            let p = render::render(&bs.scene, &strips)?;
+            let strips_ms = ms(t);
+            let t = Instant::now();
+            let q = render::render(&bs.scene, &occluded)?;
+            if k >= s.warmup {
+                strips_total.push(strips_ms);
+                occ_total.push(ms(t));
+            }
+            identical &= q.rgb == r.rgb && q.depth == r.depth && p.rgb == r.rgb;
+            occ_stats = Some(q.stats);
+        }
     }
     let mut o = Summary::of(&total).json();
     o["threads"] = json!(threads);
@@ -383,6 +408,17 @@ fn render_fn_section(
     o["raster_median_ms"] = json!(median(&raster));
     o["color"] = json!("rgb888");
     o["checksum"] = json!(format!("{checksum:016x}"));
+    if let Some(st) = occ_stats {
+        let submitted = st.submitted.max(1) as f64;
+        let mut q = Summary::of(&occ_total).json();
+        q["strips_median_ms"] = json!(median(&strips_total));
+        q["speedup"] = json!(median(&strips_total) / median(&occ_total));
+        q["culled_occlusion"] = json!(st.culled_occlusion);
+        q["culled_occlusion_fraction"] = json!(st.culled_occlusion as f64 / submitted);
+        q["reaching_setup"] = json!(st.submitted - st.dropped());
+        q["identical"] = json!(identical);
+        o["occlusion"] = q;
+    }
     Ok(o)
 }
 
