@@ -48,9 +48,11 @@ pub mod big;
 pub mod clipless;
 pub mod clusters;
 mod drawer;
+pub mod occlusion;
 pub mod shading;
 
 pub use clusters::{run_clusters, ClusterInput};
+pub use occlusion::{run_occlusion, OcclusionInput};
 pub use shading::{run_shading, ShadeInput};
 
 use big::BigMesh;
