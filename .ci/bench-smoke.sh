@@ -109,6 +109,25 @@ for r in reports:
 assert any(row["pixels_differing"] > 0 for r in reports for row in r["rows"] if row["method"] == "detail")
 PY
 
+# Occlusion culling (docs/culling.md), reduced: the herd's frames are the
+# plain ones, and from eye height the hi-z hides most of what is in the
+# frustum.
+echo "+ microraster cull --occlusion --cameras 8 --rounds 1"
+"$bin" cull --occlusion --cameras 8 --rounds 1 --json "$out/occlusion.json" >"$out/occlusion.md"
+python3 - "$out/occlusion.json" <<'PY'
+import json, sys
+rows = json.load(open(sys.argv[1]))
+assert [r["rows"] for r in rows] == [240, 16], rows
+for r in rows:
+    assert r["identical"], r
+    assert r["stored"][1] < r["stored"][0], r
+whole = rows[0]
+hidden = whole["culled_occlusion"] / (whole["submitted"] - whole["culled_object"])
+assert hidden > 0.5, whole
+print(f'occlusion: {hidden:.3f} of the triangles in the frustum hidden, '
+      f'set up {whole["stored"][0]:.0f} -> {whole["stored"][1]:.0f}')
+PY
+
 if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
   cargo bench -q -p microraster-host --features criterion --bench core --no-run
 fi
