@@ -59,7 +59,7 @@ fn object(pos: [f32; 3], size: [f32; 3], seed: u8) -> Object {
         model: Mat4::translation(Vec3::new(pos[0], pos[1], pos[2]))
             * Mat4::scale(Vec3::new(size[0], size[1], size[2])),
         colors: core::array::from_fn(|i| {
-            Rgb888::new(seed.wrapping_mul(37), 40 * i as u8, 255 - seed)
+            Rgb888::new(seed.wrapping_mul(37), (40 * i) as u8, 255 - seed)
         }),
     }
 }
