@@ -204,6 +204,10 @@ pub enum Error {
         /// Tiles given.
         actual: usize,
     },
+    /// Portal data ([`PortalGraph`](crate::portal::PortalGraph)) whose
+    /// ranges or targets run past its cells or portals, with a bad box, or
+    /// a walk given a bad start cell or rectangle slice.
+    InvalidPortals(crate::portal::PortalFault),
     /// [`RasterMode::Clipless`] given to a [`Frame`](crate::Frame), whose
     /// setup storage holds snapped triangles only (draw clipless triangles
     /// with a [`StripRenderer`](crate::StripRenderer)), or to any receiver
@@ -280,6 +284,20 @@ impl core::fmt::Display for Error {
                 crate::cull::ClusterFault::Node(i) => {
                     write!(f, "cluster node {i} does not tile its clusters")
                 }
+            },
+            Error::InvalidPortals(fault) => match fault {
+                crate::portal::PortalFault::Cell(i) => {
+                    write!(f, "portal cell {i}'s portal range runs past the portals")
+                }
+                crate::portal::PortalFault::Portal(i) => write!(
+                    f,
+                    "portal {i} leads to no cell or its box is not finite with min <= max"
+                ),
+                crate::portal::PortalFault::Start => write!(f, "the start cell is not a cell"),
+                crate::portal::PortalFault::Rects { expected, actual } => write!(
+                    f,
+                    "{actual} portal rectangles given for {expected} cells"
+                ),
             },
             Error::HiZSize { expected, actual } => {
                 write!(f, "{actual} hi-z tiles given, the strip needs {expected}")

@@ -69,6 +69,7 @@
 //! | counters | `stats.rs` | [`Stats`] (per triangle), [`RenderStats`] (per pixel) |
 //! | storage | `frame.rs`, `bins.rs` | [`Frame`]: set-up triangles in caller storage, per-strip [`Bins`] |
 //! | immediate mode | `strip_renderer.rs` | [`StripRenderer`]: setup straight into one strip |
+//! | portal culling | `portal.rs` | [`portal::PortalGraph::visible`]: the pixel rectangle each cell is seen through, narrowed portal by portal from the eye's cell; cells never reached are skipped whole |
 //! | occlusion culling | `occlusion.rs` | [`Occluder`]: a strip's max depth per 8x8 tile; objects (and parts) whose conservative [`ScreenBound`] fails the depth test everywhere are skipped before transform |
 //! | traversal | `raster.rs` | exact edge functions, top-left rule, spans, depth and colour steps |
 //! | depth | `depth.rs` | [`DepthBuffer`], [`DepthWord`] (`u16`, `u32`, [`DepthF32`]), [`NoDepth`], [`DepthFunc`] |
@@ -97,6 +98,7 @@ pub mod bins;
 pub mod frame;
 pub mod strip_renderer;
 pub mod occlusion;
+pub mod portal;
 pub mod raster;
 pub mod depth;
 pub mod color;

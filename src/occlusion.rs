@@ -71,7 +71,7 @@ pub const fn tiles_for(width: u32, rows: u32) -> usize {
 
 /// The vertex stage's `f32` error relative to the magnitudes, with room
 /// to spare (as [`BoundingSphere::outside_frustum`] uses).
-const GAMMA: f64 = 16.0 / 16_777_216.0;
+pub(crate) const GAMMA: f64 = 16.0 / 16_777_216.0;
 
 /// The depth interpolation's margin, in `Z32` units: four `u16` LSBs.
 const Z_MARGIN: u32 = 1 << 18;

@@ -59,6 +59,10 @@ pub struct Stats {
     /// Skipped before transform because the strip's hi-z hides its object
     /// ([`Occluder`](crate::occlusion::Occluder)).
     pub culled_occlusion: u64,
+    /// Skipped with their cell, never submitted, because no chain of
+    /// portals lets the eye see it ([`portal`](crate::portal); counted by
+    /// the caller that skips them).
+    pub culled_portal: u64,
 }
 
 impl Stats {
@@ -78,6 +82,7 @@ impl Stats {
             self.culled_detail,
             self.culled_mask,
             self.culled_occlusion,
+            self.culled_portal,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
@@ -101,6 +106,7 @@ impl Stats {
             culled_detail: self.culled_detail.saturating_add(o.culled_detail),
             culled_mask: self.culled_mask.saturating_add(o.culled_mask),
             culled_occlusion: self.culled_occlusion.saturating_add(o.culled_occlusion),
+            culled_portal: self.culled_portal.saturating_add(o.culled_portal),
         }
     }
 }

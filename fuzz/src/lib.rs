@@ -49,10 +49,12 @@ pub mod clipless;
 pub mod clusters;
 mod drawer;
 pub mod occlusion;
+pub mod portal;
 pub mod shading;
 
 pub use clusters::{run_clusters, ClusterInput};
 pub use occlusion::{run_occlusion, OcclusionInput};
+pub use portal::{run_portal, PortalInput};
 pub use shading::{run_shading, ShadeInput};
 
 use big::BigMesh;
@@ -952,6 +954,7 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         culled_detail: b.culled_detail - a.culled_detail,
         culled_mask: b.culled_mask - a.culled_mask,
         culled_occlusion: b.culled_occlusion - a.culled_occlusion,
+        culled_portal: b.culled_portal - a.culled_portal,
     }
 }
 
