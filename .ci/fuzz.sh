@@ -7,7 +7,7 @@
 # the default backend (`--no-default-features`, its own target dir), so
 # `Mat4::perspective` and `BoundingSphere::from_points` run on micromath.
 # Targets: frame, strip_renderer, clusters (cluster culling, honest and
-# arbitrary sets), occlusion (honest and arbitrary bounds and tile counts), clipless (the clipless mode: no panic, splits alike), shading (every shading: colours, lit
+# arbitrary sets), occlusion (honest and arbitrary bounds and tile counts), portal (arbitrary cells, portals and boxes: typed errors, rectangles in the frame), clipless (the clipless mode: no panic, splits alike), shading (every shading: colours, lit
 # colours, textures, Phong; ids, depth and counters independent of it).
 # Before fuzzing, every file in fuzz/findings/ (minimised inputs of fixed
 # core issues, README.md there; the .md files skipped) is replayed once
@@ -37,7 +37,7 @@ cd "$(dirname "$0")/.."
 # FUZZ_SECONDS per target in all: two thirds on the libm build, a third
 # on the micromath build (unless FUZZ_BUILDS names one only).
 TOTAL_SECONDS=${FUZZ_SECONDS:-60}
-TARGETS=${FUZZ_TARGETS:-"frame strip_renderer shading clusters clipless occlusion"}
+TARGETS=${FUZZ_TARGETS:-"frame strip_renderer shading clusters clipless occlusion portal"}
 BUILDS=${FUZZ_BUILDS:-"libm micromath"}
 if [ "$(echo $BUILDS | wc -w)" -gt 1 ]; then
   MICROMATH_SECONDS=$(( TOTAL_SECONDS / 3 ))

@@ -13,6 +13,7 @@
 //! | `bunny-subdiv` | the bunny with every triangle split 1→4 at its edge midpoints, twice (1,111,216 triangles) | 1920x1080 |
 //! | `quad` | two flat triangles covering the whole frame at depth 0.5 | 1920x1080 |
 //! | `spots` | a 10x10 grid of Spot (5,856 triangles each, 585,600 in all), Gouraud, seen from eye height outside the grid, drawn front to back (the occlusion-culling scene, `docs/culling.md`) | 320x240 |
+//! | `house` | an 8x8 house of rooms joined by doors, each with two crates and a ball (54,744 triangles), seen from camera 0 of `portal::house_camera`; with `View::portals`, only the rooms seen through doors (the portal-culling scene, `docs/culling.md`) | 320x240 |
 //!
 //! The sphere has exactly `2 * stacks * slices` triangles like tgx's: each
 //! (stack, slice) cell is a quad split into two triangles, including the
@@ -32,7 +33,15 @@ use std::collections::HashMap;
 use std::path::Path;
 
 /// Names of the built-in scenes.
-pub const NAMES: [&str; 6] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad", "spots"];
+pub const NAMES: [&str; 7] = [
+    "cubes",
+    "sphere",
+    "bunny",
+    "bunny-subdiv",
+    "quad",
+    "spots",
+    "house",
+];
 
 /// The bunny mesh shipped in the repository.
 pub const BUNNY_OBJ: &str = concat!(
@@ -134,7 +143,7 @@ pub fn default_size(name: &str) -> (u32, u32) {
     match name {
         "cubes" => (800, 600),
         "sphere" => (240, 320),
-        "spots" => (320, 240),
+        "spots" | "house" => (320, 240),
         _ => (1920, 1080),
     }
 }
@@ -151,6 +160,7 @@ pub fn builtin(name: &str, view: &View) -> Result<BenchScene, String> {
         "bunny" => (bunny_scene(view, 0)?, None),
         "bunny-subdiv" => (bunny_scene(view, 2)?, None),
         "spots" => (spots_scene(view)?, None),
+        "house" => (crate::portal::house_scene(view)?.0, None),
         "quad" if view.has_camera() => return Err(NO_CAMERA_QUAD.to_string()),
         "quad" => (quad_scene(), None),
         other => {

@@ -26,7 +26,15 @@ use crate::image_out::{image_format, MAX_DIMENSION};
 
 /// Names accepted by `--scene`.
 /// (`crate::bench_scenes` builds them; see there for what each one is.)
-pub const SCENES: [&str; 6] = ["cubes", "sphere", "bunny", "bunny-subdiv", "quad", "spots"];
+pub const SCENES: [&str; 7] = [
+    "cubes",
+    "sphere",
+    "bunny",
+    "bunny-subdiv",
+    "quad",
+    "spots",
+    "house",
+];
 
 /// The scenes of `report speed-vs-error`, in order.
 pub const REPORT_SCENES: [&str; 5] = ["cubes", "spot", "teapot", "bunny", "layers"];
@@ -268,6 +276,12 @@ pub struct RenderArgs {
     /// buffer and --mode clipping.
     #[arg(long)]
     pub occlusion: bool,
+
+    /// Portal culling (see docs/culling.md), for --scene house: only the
+    /// rooms the eye can see through chains of doors are submitted. The
+    /// image is the same.
+    #[arg(long)]
+    pub portals: bool,
 
     /// Detail culling (lossy; 0: off): drop objects, and with
     /// --cull-clusters clusters, whose projection is provably less than PX
@@ -902,6 +916,16 @@ pub struct CullArgs {
     /// Spots a side of the occlusion scene's grid.
     #[arg(long, value_name = "N", default_value = "10")]
     pub grid: usize,
+
+    /// Measure portal culling instead, on the generated house (rooms and
+    /// doors; the models are ignored): the table of docs/culling.md's
+    /// "Portal culling".
+    #[arg(long, conflicts_with = "occlusion")]
+    pub portals: bool,
+
+    /// Rooms a side of the portal scene's house.
+    #[arg(long, value_name = "N", default_value = "8")]
+    pub rooms: usize,
 
     /// Strip heights for the occlusion table.
     #[arg(

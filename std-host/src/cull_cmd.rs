@@ -159,6 +159,22 @@ pub struct MaskReport {
 
 /// Runs the command.
 pub fn run(args: &CullArgs) -> Result<(), String> {
+    if args.portals {
+        let row = crate::portal::measure(args.rooms, args.cameras, args.size, args.rounds)?;
+        if let Some(path) = &args.json {
+            let text = serde_json::to_string_pretty(&row).map_err(|e| e.to_string())?;
+            crate::output::write_all(&[crate::output::Output {
+                option: "--json",
+                path,
+                payload: crate::output::Payload::Raw(text.as_bytes()),
+            }])?;
+        }
+        print!(
+            "{}",
+            crate::portal::markdown(&row, args.rooms, args.cameras, args.size)
+        );
+        return Ok(());
+    }
     if args.occlusion {
         let rows = crate::occlusion::measure(
             args.grid,

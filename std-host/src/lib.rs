@@ -40,6 +40,7 @@ pub mod obj;
 pub mod occlusion;
 pub mod output;
 pub mod pipeline;
+pub mod portal;
 pub mod render;
 pub mod render_cmd;
 #[cfg(feature = "report")]

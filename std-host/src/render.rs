@@ -155,6 +155,9 @@ pub struct Counters {
     /// Skipped before transform, hidden behind the strip's hi-z
     /// (`--occlusion`; counted once per strip the object reaches).
     pub culled_occlusion: u64,
+    /// Skipped with their rooms, never submitted, by portal culling
+    /// (`--portals`; counted in `submitted` too).
+    pub culled_portal: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -174,6 +177,7 @@ impl From<&Stats> for Counters {
             culled_detail: s.culled_detail,
             culled_mask: s.culled_mask,
             culled_occlusion: s.culled_occlusion,
+            culled_portal: s.culled_portal,
         }
     }
 }

@@ -73,6 +73,7 @@ fn view_of(args: &RenderArgs) -> View {
         target: args.target,
         fov: args.fov,
         inv_w: args.depth_kind == crate::cli::DepthKindArg::InvW,
+        portals: args.portals,
     }
 }
 
@@ -326,6 +327,10 @@ fn nonzero(c: &Counters) -> String {
             "hidden behind the strip's hi-z (before transform, per strip)",
             c.culled_occlusion,
         ),
+        (
+            "in rooms no door shows (portals, never submitted)",
+            c.culled_portal,
+        ),
         ("degenerate", c.culled_degenerate),
         ("non-finite", c.rejected_nonfinite),
         ("index out of range", c.rejected_index),
@@ -419,6 +424,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             }
         }
     }
+    if args.portals && !matches!(args.source(), Source::Scene(ref n) if n == "house") {
+        return Err("--portals needs a scene with rooms and doors: --scene house".to_string());
+    }
     let (r, load_warnings) = match args.source() {
         Source::Obj(_) if args.normal_masks.is_some() => {
             return Err(
@@ -435,7 +443,19 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             )
         }
         Source::Obj(path) => render_obj(args, &path, &opts)?,
-        _ => (render::render(&load_scene(args)?, &opts)?, Vec::new()),
+        _ => {
+            let mut r = render::render(&load_scene(args)?, &opts)?;
+            // Rooms skipped by portal culling were never submitted: counted
+            // as submitted and culled, as the core counts its own skips.
+            if let (true, Source::Scene(name)) = (args.portals, args.source()) {
+                if name == "house" {
+                    let (_, report) = crate::portal::house_scene(&view_of(args))?;
+                    r.stats.submitted += report.triangles;
+                    r.stats.culled_portal += report.triangles;
+                }
+            }
+            (r, Vec::new())
+        }
     };
 
     let ids_rgba: Option<Vec<u8>> = r

@@ -136,6 +136,9 @@ pub struct View {
     /// 1/w depth: [`Mat4::perspective_inv_w`] (window depth `near / w`,
     /// reversed, no far plane) instead of [`Mat4::perspective`].
     pub inv_w: bool,
+    /// Portal culling, in a scene with cells and portals (`house`): only
+    /// the rooms the eye can see through doors are drawn.
+    pub portals: bool,
 }
 
 impl View {
@@ -148,6 +151,7 @@ impl View {
             target: None,
             fov: None,
             inv_w: false,
+            portals: false,
         }
     }
 

@@ -868,3 +868,24 @@ fn report_without_the_feature_is_an_error_naming_it() {
     assert!(e.contains("--features report"), "{e}");
     assert!(!out.exists());
 }
+
+/// `render --portals` on the house: the same image, the skipped rooms'
+/// triangles counted as submitted and culled; refused without rooms.
+#[test]
+fn portals_draw_the_same_house_and_count_the_rooms() {
+    let size = ["--scene", "house", "--size", "160x120", "--threads", "2"];
+    let (all, _) = stats(&size);
+    let mut with = size.to_vec();
+    with.push("--portals");
+    let (culled, _) = stats(&with);
+    assert_eq!(all["checksum"], culled["checksum"]);
+    let c = |v: &Value, k: &str| v["counters"][k].as_u64().unwrap();
+    assert_eq!(c(&all, "submitted"), c(&culled, "submitted"));
+    assert_eq!(c(&all, "culled_portal"), 0);
+    assert!(c(&culled, "culled_portal") * 2 > c(&culled, "submitted"));
+    assert!(c(&culled, "stored") < c(&all, "stored"));
+    let out = tmp("portals-cubes.png");
+    let e = fails(&["render", "--portals", "--out", out.to_str().unwrap()]);
+    assert!(e.contains("--scene house"), "{e}");
+    assert!(!out.exists());
+}

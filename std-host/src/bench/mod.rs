@@ -170,6 +170,7 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
         target: args.target,
         fov: args.fov,
         inv_w: false,
+        portals: false,
     };
     let mut bs = match &args.obj {
         Some(path) => {
