@@ -128,6 +128,21 @@ print(f'occlusion: {hidden:.3f} of the triangles in the frustum hidden, '
       f'set up {whole["stored"][0]:.0f} -> {whole["stored"][1]:.0f}')
 PY
 
+# Portal culling (docs/culling.md), all 64 cameras (under a second): the
+# frames are the plain ones and at least 80 % of the rooms are skipped.
+echo "+ microraster cull --portals --rounds 1"
+"$bin" cull --portals --rounds 1 --json "$out/portals.json" >"$out/portals.md"
+python3 - "$out/portals.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["identical"], r
+skipped = 1 - r["reached"] / r["cells"]
+assert skipped >= 0.8, r
+assert r["stored"][1] < r["stored"][0], r
+print(f'portals: {skipped:.3f} of the rooms skipped, '
+      f'set up {r["stored"][0]:.0f} -> {r["stored"][1]:.0f}')
+PY
+
 if [ "${BENCH_SMOKE_CRITERION:-0}" = 1 ]; then
   cargo bench -q -p microraster-host --features criterion --bench core --no-run
 fi
