@@ -427,6 +427,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if args.portals && !matches!(args.source(), Source::Scene(ref n) if n == "house") {
         return Err("--portals needs a scene with rooms and doors: --scene house".to_string());
     }
+    if args.portals && args.id_out.is_some() {
+        return Err(
+            "--id-out with --portals would number only the rooms drawn; render the ids without --portals"
+                .to_string(),
+        );
+    }
     let (r, load_warnings) = match args.source() {
         Source::Obj(_) if args.normal_masks.is_some() => {
             return Err(

@@ -888,4 +888,17 @@ fn portals_draw_the_same_house_and_count_the_rooms() {
     let e = fails(&["render", "--portals", "--out", out.to_str().unwrap()]);
     assert!(e.contains("--scene house"), "{e}");
     assert!(!out.exists());
+    let ids = tmp("portals-ids.png");
+    let e = fails(&[
+        "render",
+        "--scene",
+        "house",
+        "--portals",
+        "--id-out",
+        ids.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(e.contains("--id-out"), "{e}");
+    assert!(!out.exists() && !ids.exists());
 }
