@@ -12,7 +12,9 @@
 # same for baked, textured, lit Spot in its six shading variants (after
 # checking that the committed bakes are what `microraster bake` writes,
 # and that the unlit and untextured variants link no lighting or texture
-# code), with its own table. Then the configuration sweep of the cubes on
+# code), with its own table, and Spot in cluster order on the M4F with
+# the cluster tests of docs/culling.md (the same frame, fewer
+# instructions). Then the configuration sweep of the cubes on
 # the M4F and the M0 (subpixel bits, depth buffer, float backend, the i32
 # edge fast path: the speed axis of `microraster report speed-vs-error`),
 # with its own table of record.
@@ -40,10 +42,11 @@ step "baked Spot is what microraster bake writes today (examples/firmware/baked)
 cargo build -q --release -p microraster-host
 bake=$(mktemp -d)
 target/release/microraster bake --out "$bake/full" --texture assets/models/spot_texture.png \
-  --texture-size 256 assets/models/spot.obj >/dev/null
+  --texture-size 256 --clusters assets/models/spot.obj >/dev/null
 target/release/microraster bake --out "$bake/small" --texture assets/models/spot_texture.png \
   --texture-size 128 --max-triangles 1500 assets/models/spot.obj >/dev/null
 diff -q "$bake/full/spot.rs" examples/firmware/baked/spot.rs
+diff -q "$bake/full/spot_clusters.rs" examples/firmware/baked/spot_clusters.rs
 diff -q "$bake/small/spot.rs" examples/firmware/baked/small/spot.rs
 rm -r "$bake"
 echo "baked Spot up to date"
@@ -65,6 +68,8 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
       cargo clippy -q --release --target "$target" --features "$v" -- -D warnings
     done
   done
+  # Cluster culling of Spot: the MPS2 boards only (all of Spot).
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-volumes -- -D warnings
 )
 
 expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
@@ -344,6 +349,47 @@ for b in "${boards[@]}"; do
   done
 done
 
+# Cluster culling of Spot (issue 11) on the M4F: Spot in cluster order
+# (baked/spot_clusters.rs), the baseline with every cluster drawn and the
+# three cluster tests; each frame bit-identical to the host's unculled
+# one (build.rs) and to host-checksums.txt, counts of record in
+# docs/embedded.md.
+cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
+cluster_rows=()
+target=thumbv7em-none-eabihf board=mps2-an386
+for v in "${cluster_variants[@]}"; do
+  step "$board ($target), Spot clusters: $v"
+  out=$log/$board-${v//,/+}.txt
+  set +e
+  timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
+  rc=$?
+  set -e
+  cat "$out"
+  elf=target/$target/release/microraster-firmware
+  if [ "$rc" -ne 0 ]; then
+    echo "FAIL: $board $v exited $rc"
+    failed=1
+    continue
+  fi
+  got=$(awk '$1 == "checksum" { print $2 }' "$out")
+  want=$(expected "${v%%,*}-clusters")
+  if [ -z "$want" ] || [ "$got" != "$want" ]; then
+    echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} (${v%%,*}-clusters)"
+    failed=1
+  fi
+  case $v in *cull-*)
+    if ! grep -q 'skipped before transform [1-9]' "$out"; then
+      echo "FAIL: $board $v skipped no triangle"
+      failed=1
+    fi ;;
+  esac
+  read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+  parse_run "$out"
+  check_ram "$board" "$v" || failed=1
+  cluster_rows+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
+  check_counts "$board" "$v" "$frame $display $render $clears $geometry $raster" || failed=1
+done
+
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
 # the M0, bit-identical to the host's clipless frame, counts of record in
 # docs/embedded.md like the rows above.
@@ -397,6 +443,11 @@ step "Spot, shading variants (320x240 Rgb565, u16 depth, immediate; the same tab
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${spot_rows[@]}"
+
+step "Spot, cluster culling on the M4F (the same table in docs/embedded.md and docs/culling.md)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${cluster_rows[@]}"
 
 step "configurations, the report's speed axis (cubes, set up once; the same table in docs/embedded.md)"
 echo "$config_header"

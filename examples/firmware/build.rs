@@ -29,6 +29,9 @@
 //! `StripRenderer::with_shader`. The micro:bit gets the decimated bake
 //! (`cfg(small_spot)`), and `spot-gouraud`'s per-vertex colours are
 //! written here as a static (`spot_colors.rs`) so that they sit in flash.
+//! With `clusters` (and `cull-*`) the triangles are in the baked cluster
+//! order (`baked/spot_clusters.rs`) and the frame is drawn unculled here:
+//! the firmware's cluster tests must leave it unchanged.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
 #[cfg(not(feature = "spot"))]
@@ -65,12 +68,56 @@ mod spot_full {
 mod spot_small {
     include!("baked/small/spot.rs");
 }
+/// All of Spot's triangles in cluster order, with the cluster set
+/// (`microraster bake --clusters`), for the `clusters` features.
+#[cfg(feature = "clusters")]
+#[allow(dead_code)]
+mod spot_clusters {
+    include!("baked/spot_clusters.rs");
+}
+
+/// The order of Spot's triangles: Morton order of their centroids (see
+/// [`morton_order`]), or with `clusters` the baked cluster order.
+#[cfg(feature = "spot")]
+fn spot_order(positions: &[microraster::Vec3], indices: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    #[cfg(feature = "clusters")]
+    {
+        let _ = (positions, indices);
+        spot_clusters::CLUSTER_INDICES.to_vec()
+    }
+    #[cfg(not(feature = "clusters"))]
+    morton_order(positions, indices)
+}
+
+/// The runs of Spot's triangles a strip tests by sphere: every
+/// `CHUNK_TRIANGLES`, or with `clusters` the clusters.
+#[cfg(feature = "spot")]
+fn spot_runs(triangles: usize) -> Vec<[usize; 2]> {
+    #[cfg(feature = "clusters")]
+    {
+        let _ = triangles;
+        spot_clusters::CLUSTERS
+            .iter()
+            .map(|c| c.triangles.map(|t| t as usize))
+            .collect()
+    }
+    #[cfg(not(feature = "clusters"))]
+    (0..triangles)
+        .step_by(spot_scene::CHUNK_TRIANGLES)
+        .map(|a| [a, (a + spot_scene::CHUNK_TRIANGLES).min(triangles)])
+        .collect()
+}
 
 /// Spot's rows per strip (immediate mode, 1,280 B a row of colour and
 /// depth; the stack needs 2.5 to 3.5 KB beside them). MPS2 (24 KB): 16
 /// rows, 15 strips (17 would fit but still take 15 strips). micro:bit
 /// (16 KB): 9 rows, 27 strips (10 would leave `spot-phong` 64 bytes).
 const SPOT_ROWS_MPS2: u32 = 16;
+/// With `clusters` (baseline included, so that it draws the same
+/// strips): the eye and the walk of the cluster tree take 336 B more
+/// stack, which at 16 rows would leave `spot-lit` 36 B of the 24 KB and
+/// the textured and Phong shadings none.
+const SPOT_ROWS_MPS2_CLUSTERS: u32 = 15;
 const SPOT_ROWS_MICROBIT: u32 = 9;
 
 struct Board {
@@ -91,6 +138,7 @@ fn board(target: &str, immediate: bool, spot: bool, depth_u32: bool, clipless: b
             // (the model and texture are in flash).
             match target {
                 "thumbv6m-none-eabi" => SPOT_ROWS_MICROBIT,
+                _ if cfg!(feature = "clusters") => SPOT_ROWS_MPS2_CLUSTERS,
                 _ => SPOT_ROWS_MPS2,
             }
         } else if depth_u32 {
@@ -244,7 +292,7 @@ fn spot_model(small: bool) -> spot_scene::Model<'static> {
         ($m:ident) => {
             spot_scene::Model {
                 positions: &$m::POSITIONS,
-                indices: Vec::leak(morton_order(&$m::POSITIONS, &$m::INDICES)),
+                indices: Vec::leak(spot_order(&$m::POSITIONS, &$m::INDICES)),
                 normals: &$m::NORMALS,
                 uvs: &$m::UVS,
                 texture: &$m::TEXTURE,
@@ -335,7 +383,7 @@ fn spot_frame(out: &std::path::Path, small: bool) -> u64 {
 /// The triangles of `indices` in Morton order of their centroids (10 bits
 /// an axis over the model's box), so that runs of consecutive triangles
 /// are compact. Stable: ties keep the baked order.
-#[cfg(feature = "spot")]
+#[cfg(all(feature = "spot", not(feature = "clusters")))]
 fn morton_order(positions: &[microraster::Vec3], indices: &[[u32; 3]]) -> Vec<[u32; 3]> {
     let centroid = |t: &[u32; 3]| {
         let p = t.map(|i| positions[i as usize]);
@@ -371,11 +419,12 @@ fn morton_order(positions: &[microraster::Vec3], indices: &[[u32; 3]]) -> Vec<[u
 }
 
 /// `spot_chunks.rs`: the mesh's triangles (in Morton order, see
-/// `morton_order`; the host's frame draws them in the same order) in runs
-/// of `spot_scene::CHUNK_TRIANGLES`, each with a sphere around its
-/// vertices (`BoundingSphere::from_points`), for flash. A strip renderer
-/// skips a run whose sphere lies outside its rows before it transforms a
-/// vertex.
+/// `morton_order`, or in cluster order with `clusters`; the host's frame
+/// draws them in the same order) in runs (`spot_runs`: of
+/// `spot_scene::CHUNK_TRIANGLES`, or the clusters), each with a sphere
+/// around its vertices (`BoundingSphere::from_points`), for flash. A strip
+/// renderer skips a run whose sphere lies outside its rows before it
+/// transforms a vertex.
 #[cfg(feature = "spot")]
 fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
     let mut s = String::from(
@@ -392,10 +441,10 @@ fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
         writeln!(s, "    [{}, {}, {}],", t[0], t[1], t[2]).unwrap();
     }
     s.push_str("];\n");
-    let chunks: Vec<_> = model
-        .indices
-        .chunks(spot_scene::CHUNK_TRIANGLES)
-        .map(|tris| {
+    let chunks: Vec<_> = spot_runs(model.indices.len())
+        .into_iter()
+        .map(|[a, b]| {
+            let tris = &model.indices[a..b];
             let points: Vec<_> = tris
                 .iter()
                 .flatten()
@@ -433,6 +482,12 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(small_spot)");
     if spot && small {
         println!("cargo::rustc-cfg=small_spot");
+    }
+    if small && cfg!(feature = "clusters") {
+        panic!(
+            "the `clusters` features are for the MPS2 boards (all of Spot); \
+             the micro:bit's decimated Spot has no cluster bake"
+        );
     }
     let depth_u32 = env::var_os("CARGO_FEATURE_DEPTH_U32").is_some();
     let clipless = env::var_os("CARGO_FEATURE_CLIPLESS").is_some();

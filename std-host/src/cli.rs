@@ -822,6 +822,12 @@ pub struct BakeArgs {
     /// and no MTL, such as Spot).
     #[arg(long, value_name = "PNG")]
     pub texture: Option<PathBuf>,
+
+    /// Also write `<model>_clusters.rs`: the triangles in cluster order
+    /// and the cluster set (clusters, tree, vertex list) of cluster
+    /// culling, over the same baked vertices (default cluster options).
+    #[arg(long)]
+    pub clusters: bool,
 }
 
 /// The models `cull` measures by default (in the repository).

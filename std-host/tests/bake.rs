@@ -474,3 +474,138 @@ fn bake_errors_are_one_line_with_status_1() {
     assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+/// The `[a, b, c],` rows of the `[[u32; 3]; _]` array `name` in `src`.
+fn triangles_of(src: &str, name: &str) -> Vec<[u32; 3]> {
+    let start = src
+        .find(&format!("pub static {name}:"))
+        .unwrap_or_else(|| panic!("no {name}"));
+    let body = &src[start..];
+    let close = body.find("\n];").unwrap();
+    body[..close]
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<u32> = l
+                .trim()
+                .trim_start_matches('[')
+                .trim_end_matches("],")
+                .split(", ")
+                .map(|x| x.parse().unwrap())
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// A triangle rotated so its smallest index is first (winding kept).
+fn canonical(t: [u32; 3]) -> [u32; 3] {
+    let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+}
+
+#[test]
+fn the_cluster_bake_reorders_the_models_own_triangles_and_fits_its_counts() {
+    let mesh = load_obj_shaded(&models().join("spot.obj"), None).unwrap();
+    let opts = BakeOptions {
+        max_triangles: Some(600),
+        ..spot_opts()
+    };
+    let (model, report) = bake_source(&mesh, "spot", "spot", &opts).unwrap();
+    let (src, c) = bake::cluster_source(&mesh, "spot", &opts).unwrap();
+    assert_eq!(bake::cluster_source(&mesh, "spot", &opts).unwrap().0, src);
+    // The same triangles, winding kept, over the model file's vertices.
+    let mut baked: Vec<_> = triangles_of(&model, "INDICES")
+        .into_iter()
+        .map(canonical)
+        .collect();
+    let mut clustered: Vec<_> = triangles_of(&src, "CLUSTER_INDICES")
+        .into_iter()
+        .map(canonical)
+        .collect();
+    assert_eq!(clustered.len(), report.triangles);
+    baked.sort_unstable();
+    clustered.sort_unstable();
+    assert_eq!(
+        baked, clustered,
+        "the cluster order is a permutation of INDICES"
+    );
+    assert!(c.clusters > 1 && c.nodes >= c.clusters && c.inner_nodes == c.nodes - c.clusters);
+    assert_eq!(src.matches("microraster::Cluster {").count(), c.clusters);
+    assert_eq!(entries(&src, "CLUSTER_VERTICES"), c.list_entries);
+    assert!(src.contains(&format!("pub const CLUSTER_COUNT: usize = {};", c.clusters)));
+    assert!(src.contains(&format!(
+        "pub const CLUSTER_NODE_COUNT: usize = {};",
+        c.nodes
+    )));
+    assert_eq!(src.matches("microraster::ClusterNode {").count(), c.nodes);
+    // Every vertex list entry names one of the model's vertices.
+    assert!(src
+        .split("pub static CLUSTER_VERTICES")
+        .nth(1)
+        .unwrap()
+        .split(|ch: char| !ch.is_ascii_digit())
+        .filter_map(|x| x.parse::<usize>().ok())
+        .skip(2) // `u32` and the array length
+        .all(|v| v < report.vertices));
+}
+
+#[test]
+fn float_literals_read_back_bit_for_bit() {
+    let mut x = 0x0001_2345u32;
+    let mut values = vec![
+        0.0,
+        -0.0,
+        1.0,
+        -1.5,
+        f32::MIN_POSITIVE,
+        f32::MAX,
+        f32::MIN,
+        1e-45,
+        0.1,
+    ];
+    for _ in 0..10_000 {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        let v = f32::from_bits(x);
+        if v.is_finite() {
+            values.push(v);
+        }
+    }
+    for v in values {
+        let lit = bake::f32_literal(v);
+        assert_eq!(lit.parse::<f32>().unwrap().to_bits(), v.to_bits(), "{lit}");
+    }
+    assert_eq!(bake::f32_literal(f32::INFINITY), "f32::INFINITY");
+    assert_eq!(bake::f32_literal(f32::NEG_INFINITY), "f32::NEG_INFINITY");
+    assert_eq!(bake::f32_literal(f32::NAN), "f32::NAN");
+}
+
+#[test]
+fn bake_clusters_writes_both_files_or_neither() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_microraster"))
+        .arg("bake")
+        .arg(models().join("spot.obj"))
+        .args(["--max-triangles", "400", "--clusters", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("clusters: "), "{out}");
+    assert!(dir.path().join("spot.rs").is_file());
+    assert!(dir.path().join("spot_clusters.rs").is_file());
+    // A bake that fails writes nothing: not the model, not the clusters.
+    let empty = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_microraster"))
+        .arg("bake")
+        .arg(models().join("spot.obj"))
+        .args(["--max-triangles", "1", "--clusters", "--out"])
+        .arg(empty.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(std::fs::read_dir(empty.path()).unwrap().count(), 0);
+}

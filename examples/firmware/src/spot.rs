@@ -29,9 +29,13 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use embedded_graphics_core::geometry::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
+#[cfg(feature = "clusters")]
+use microraster::cull::{Eye, Visit};
 use microraster::pixelcolor::{Rgb565, RgbColor};
 use microraster::StripSink;
 use microraster::{Attributes, Config, FragmentShader, Mat4, Mesh, StripRenderer, Submit};
+#[cfg(feature = "clusters")]
+use microraster::{ClusterCull, ClusterSet, ClusterTest};
 
 /// The baked model (`microraster bake`, see docs/embedded.md).
 #[cfg(not(small_spot))]
@@ -55,6 +59,111 @@ mod chunks {
     include!(concat!(env!("OUT_DIR"), "/spot_chunks.rs"));
 }
 
+/// The cluster set of Spot (`microraster bake --clusters`); `chunks`
+/// holds the same triangle order and one sphere per cluster.
+#[cfg(feature = "clusters")]
+#[allow(dead_code)]
+mod clustered {
+    include!("../baked/spot_clusters.rs");
+}
+
+#[cfg(all(feature = "clusters", small_spot))]
+compile_error!("the `clusters` features are for the MPS2 boards (all of Spot)");
+
+#[cfg(feature = "clusters")]
+const _: () = assert!(
+    cfg!(feature = "cull-volumes") as u8
+        + cfg!(feature = "cull-volumes-tree") as u8
+        + cfg!(feature = "cull-cones") as u8
+        <= 1,
+    "pick one cluster test: cull-volumes, cull-volumes-tree or cull-cones"
+);
+
+/// The cluster test of the build: `None` with `clusters` alone (every
+/// cluster drawn, each triangle culled on its own: the baseline).
+#[cfg(feature = "clusters")]
+const CULL: Option<ClusterCull> = if cfg!(feature = "cull-volumes") {
+    Some(ClusterCull {
+        test: ClusterTest::Volumes,
+        hierarchy: false,
+    })
+} else if cfg!(feature = "cull-volumes-tree") {
+    Some(ClusterCull {
+        test: ClusterTest::Volumes,
+        hierarchy: true,
+    })
+} else if cfg!(feature = "cull-cones") {
+    Some(ClusterCull {
+        test: ClusterTest::Cones,
+        hierarchy: false,
+    })
+} else {
+    None
+};
+
+/// The build's name for the cluster test, for the first line.
+#[cfg(feature = "clusters")]
+const CULL_NAME: &str = if cfg!(feature = "cull-volumes") {
+    "clusters culled by volumes at the leaves"
+} else if cfg!(feature = "cull-volumes-tree") {
+    "clusters culled by volumes over the tree"
+} else if cfg!(feature = "cull-cones") {
+    "clusters culled by normal cones at the leaves"
+} else {
+    "in cluster order, each triangle culled on its own"
+};
+#[cfg(not(feature = "clusters"))]
+const CULL_NAME: &str = "in Morton order";
+
+#[cfg(feature = "clusters")]
+fn cluster_set() -> ClusterSet<'static> {
+    ClusterSet {
+        clusters: &clustered::CLUSTERS,
+        nodes: &clustered::CLUSTER_NODES,
+        vertices: &clustered::CLUSTER_VERTICES,
+    }
+}
+
+/// The eye the cluster tests use this frame (`Eye::for_frame`, with the
+/// size guard): `None` draws every cluster.
+#[cfg(feature = "clusters")]
+fn cluster_eye(mvp: &Mat4, config: &Config) -> Option<Eye> {
+    CULL.and_then(|_| Eye::for_frame::<8>(mvp, config))
+}
+
+/// What the frame's cluster test decided, once for all strips: a bit per
+/// cluster, set where it is drawn (46 bytes for Spot's 366 clusters;
+/// nothing without `clusters`).
+#[cfg(feature = "clusters")]
+type Drawn = [u32; clustered::CLUSTER_COUNT.div_ceil(32)];
+#[cfg(not(feature = "clusters"))]
+type Drawn = ();
+
+/// Walks the cluster tree once with `eye` (none: every cluster drawn).
+#[cfg(feature = "clusters")]
+fn drawn_clusters(eye: Option<&Eye>) -> Drawn {
+    let mut drawn = [0u32; clustered::CLUSTER_COUNT.div_ceil(32)];
+    cluster_set().visit(eye, None, CULL.unwrap_or_default(), |v| {
+        if let Visit::Draw(a, b) = v {
+            for k in a..b {
+                if let Some(w) = drawn.get_mut(k / 32) {
+                    *w |= 1 << (k % 32);
+                }
+            }
+        }
+    });
+    drawn
+}
+
+/// The frame's decisions: the eye found and the tree walked (with
+/// `clusters`), before the first strip.
+fn decide(mvp: &Mat4, config: &Config) -> Drawn {
+    #[cfg(feature = "clusters")]
+    return drawn_clusters(cluster_eye(mvp, config).as_ref());
+    #[cfg(not(feature = "clusters"))]
+    let _ = (mvp, config);
+}
+
 /// What a frame took, in SysTick ticks.
 struct Measured {
     /// Pixels written, or the error that stopped the frame.
@@ -69,6 +178,26 @@ struct Measured {
     one_clear: u64,
     /// The mesh submitted to a one-row strip.
     one_row: u64,
+    /// With `clusters`: what the cluster test did (see `ClusterCount`).
+    #[cfg(feature = "clusters")]
+    clusters: ClusterCount,
+}
+
+/// The frame's cluster test, measured again on its own.
+#[cfg(feature = "clusters")]
+struct ClusterCount {
+    /// Triangles skipped before transform (in every strip).
+    skipped: u64,
+    /// Decisions made (with the flat test, one per leaf: the nodes
+    /// tested; top-down, the settled nodes, fewer than tested).
+    tested: u64,
+    /// Ticks of `Eye::for_frame`.
+    eye: u64,
+    /// Ticks of the traversal into the bits of the drawn clusters.
+    traversal: u64,
+    /// Ticks of the whole mesh, unchunked and untested, submitted to a
+    /// one-row strip (every triangle's vertices transformed).
+    all_triangles: u64,
 }
 
 /// The firmware's strip loop.
@@ -97,8 +226,11 @@ impl Draw for Strips<'_> {
             display,
             t0,
         } = self;
+        // `()` without `clusters`: nothing is decided.
+        #[allow(clippy::let_unit_value)]
+        let drawn = decide(&mvp, &config);
         let strips_start = display.clock.now();
-        let written = frame(config, &mvp, color, depth, display, mesh, fragment);
+        let written = frame(config, &mvp, &drawn, color, depth, display, mesh, fragment);
         let end = display.clock.now();
 
         let clock = &mut display.clock;
@@ -118,9 +250,51 @@ impl Draw for Strips<'_> {
             fragment,
         );
         if let Ok(mut one) = one {
-            let _ = submit_chunks(&mut one, mesh, &mvp);
+            let _ = submit_chunks(&mut one, mesh, &mvp, &drawn);
         }
         let one_row = clock.now() - t;
+        #[cfg(feature = "clusters")]
+        let clusters = {
+            let (mut skipped, mut tested) = (0u64, 0u64);
+            let t = clock.now();
+            let eye = cluster_eye(&mvp, &config);
+            let t_eye = clock.now() - t;
+            let t = clock.now();
+            let again = drawn_clusters(eye.as_ref());
+            let traversal = clock.now() - t;
+            // The decisions, counted apart so that the traversal's time is
+            // its own: at the leaves, one per node tested.
+            let set = cluster_set();
+            set.visit(eye.as_ref(), None, CULL.unwrap_or_default(), |v| {
+                tested += 1;
+                if let Visit::Cull(a, b, _) = v {
+                    skipped += triangles(a, b);
+                }
+            });
+            if again != drawn {
+                skipped = u64::MAX;
+            }
+            let t = clock.now();
+            let one = StripRenderer::<_, _, 8, N, _>::with_shader(
+                config,
+                HEIGHT / 2,
+                HEIGHT / 2 + 1,
+                &mut color[..w],
+                &mut depth[..w],
+                fragment,
+            );
+            if let Ok(mut one) = one {
+                let _ = one.submit_mesh(mesh, &mvp, 0);
+            }
+            let all_triangles = clock.now() - t;
+            ClusterCount {
+                skipped,
+                tested: if eye.is_some() { tested } else { 0 },
+                eye: t_eye,
+                traversal,
+                all_triangles,
+            }
+        };
         Measured {
             written,
             setup_start: t0,
@@ -128,15 +302,19 @@ impl Draw for Strips<'_> {
             end,
             one_clear,
             one_row,
+            #[cfg(feature = "clusters")]
+            clusters,
         }
     }
 }
 
 /// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
 /// push the rows. The pixels written.
+#[allow(clippy::too_many_arguments)]
 fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
     config: Config,
     mvp: &Mat4,
+    drawn: &Drawn,
     color: &mut [Rgb565],
     depth: &mut [u16],
     display: &mut HashDisplay,
@@ -154,7 +332,7 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
         let mut strip =
             StripRenderer::<_, _, 8, N, _>::with_shader(config, y0, y1, color, depth, fragment)
                 .map_err(|_| "strip renderer")?;
-        submit_chunks(&mut strip, mesh, mvp)?;
+        submit_chunks(&mut strip, mesh, mvp, drawn)?;
         written += strip.render_stats().pixels_written;
         push(display, y0, y1, color)?;
         y0 = y1;
@@ -168,11 +346,13 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
 /// transforms their vertices. Triangle ids and order are the whole mesh's.
 /// Inlined: out of line, its frame and `submit_mesh`'s took 860 bytes more
 /// stack (`spot-phong` on the Cortex-M3 overflowed its 24 KB).
+#[cfg(not(feature = "clusters"))]
 #[inline(always)]
 fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
     strip: &mut S,
     mesh: &Mesh<'_, A>,
     mvp: &Mat4,
+    _drawn: &Drawn,
 ) -> Result<(), &'static str> {
     let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
     for (k, (indices, bounds)) in runs.zip(chunks::CHUNKS.iter()).enumerate() {
@@ -185,6 +365,48 @@ fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
         strip.submit_mesh(&run, mvp, first).map_err(|_| "submit")?;
     }
     Ok(())
+}
+
+/// With `clusters`: submits each cluster the frame's test drew (its bit
+/// in `drawn`) as a run with its sphere, as the Morton runs are submitted
+/// without clusters. A skipped cluster's vertices are never transformed;
+/// the frame is the one drawn with no cluster test (build.rs's checksum
+/// is of that frame).
+#[cfg(feature = "clusters")]
+#[inline(always)]
+fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
+    strip: &mut S,
+    mesh: &Mesh<'_, A>,
+    mvp: &Mat4,
+    drawn: &Drawn,
+) -> Result<(), &'static str> {
+    let runs = clustered::CLUSTERS.iter().zip(chunks::CHUNKS.iter());
+    for (i, (k, bounds)) in runs.enumerate() {
+        if drawn.get(i / 32).is_none_or(|w| w & (1 << (i % 32)) == 0) {
+            continue;
+        }
+        let [t0, t1] = k.triangles.map(|t| t as usize);
+        let indices = mesh.indices.get(t0..t1).ok_or("cluster range")?;
+        let run = Mesh {
+            indices,
+            bounds: Some(*bounds),
+            ..*mesh
+        };
+        strip
+            .submit_mesh(&run, mvp, t0 as u32)
+            .map_err(|_| "submit")?;
+    }
+    Ok(())
+}
+
+/// The triangles of clusters `a..b`.
+#[cfg(feature = "clusters")]
+fn triangles(a: usize, b: usize) -> u64 {
+    cluster_set().clusters.get(a..b).map_or(0, |c| {
+        c.iter()
+            .map(|k| u64::from(k.triangles[1] - k.triangles[0]))
+            .sum()
+    })
 }
 
 /// Pushes rows `y0..y1` to the display as one strip (the buffer itself,
@@ -217,6 +439,15 @@ fn main() -> ! {
         diffuse: baked::MATERIAL_DIFFUSE[0],
         colors: &colors::COLORS,
     };
+
+    #[cfg(feature = "clusters")]
+    if cluster_set()
+        .validate(model.indices.len(), model.positions.len())
+        .is_err()
+    {
+        hprintln!("FAIL: the baked cluster set does not fit the mesh");
+        exit(false)
+    }
 
     let t0 = display.clock.now();
     let config = Config::new(WIDTH, HEIGHT);
@@ -256,12 +487,13 @@ fn main() -> ! {
     let per_px = |n: u64| ratio(n, written);
 
     hprintln!(
-        "microraster firmware: {} ({}), {}x{} Rgb565, depth u16, Spot ({} triangles), {}, immediate, {} strips of {} rows",
+        "microraster firmware: {} ({}), {}x{} Rgb565, depth u16, Spot ({} triangles, {}), {}, immediate, {} strips of {} rows",
         BOARD,
         CORE,
         WIDTH,
         HEIGHT,
         model.indices.len(),
+        CULL_NAME,
         spot_scene::VARIANT,
         strips,
         STRIP_ROWS,
@@ -294,6 +526,53 @@ fn main() -> ! {
     );
     let (a, b) = per_px(raster);
     hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
+    #[cfg(feature = "clusters")]
+    {
+        let c = &m.clusters;
+        let total = model.indices.len() as u64;
+        let (a, b) = ratio(c.skipped * 100, total);
+        hprintln!(
+            "clusters {} ({} nodes): skipped before transform {} of {} triangles ({}.{} %)",
+            clustered::CLUSTERS.len(),
+            clustered::CLUSTER_NODES.len(),
+            c.skipped,
+            total,
+            a,
+            b
+        );
+        // t/r of the lecture's cost model: one node test against one
+        // triangle's processing (the whole mesh, untested, to one row).
+        if c.tested == 0 {
+            hprintln!("no cluster test: every cluster drawn");
+        }
+        let traversal = instr(c.traversal);
+        let (ta, tb) = ratio(traversal, c.tested.max(1));
+        let (ra, rb) = ratio(instr(c.all_triangles), total);
+        let d = instr(c.all_triangles) * c.tested.max(1);
+        let q = (traversal * total * 100 + d / 2) / d.max(1);
+        let (qa, qb) = (q / 100, q % 100);
+        if c.tested > 0 {
+            hprintln!(
+                "cluster test once a frame: eye {}, traversal {} ({} decisions, {}.{} each)",
+                instr(c.eye),
+                traversal,
+                c.tested,
+                ta,
+                tb,
+            );
+            hprintln!(
+                "a triangle unculled (whole mesh to one row) {}.{}; t/r {}.{:02}",
+                ra,
+                rb,
+                qa,
+                qb
+            );
+        }
+        if c.skipped == u64::MAX {
+            hprintln!("FAIL: the cluster test decided differently the second time");
+            exit(false)
+        }
+    }
     match stack {
         Some(s) => hprintln!(
             "ram statics {} B + stack high-water {} B = {} B",
