@@ -316,49 +316,15 @@ for b in "${config_boards[@]}"; do
   done
 done
 
-spot_rows=()
-for b in "${boards[@]}"; do
-  read -r target board <<<"$b"
-  for v in "${spot_variants[@]}"; do
-    step "$board ($target), Spot: $v"
-    out=$log/$board-$v.txt
-    set +e
-    timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
-    rc=$?
-    set -e
-    cat "$out"
-    elf=target/$target/release/microraster-firmware
-    if [ "$rc" -ne 0 ]; then
-      echo "FAIL: $board $v exited $rc"
-      failed=1
-      continue
-    fi
-    got=$(awk '$1 == "checksum" { print $2 }' "$out")
-    case $board in microbit) key=$v-microbit ;; *) key=$v ;; esac
-    want=$(expected "$key")
-    if [ -z "$want" ] || [ "$got" != "$want" ]; then
-      echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
-      failed=1
-    fi
-    check_linked "$board" "$v" "$elf" || failed=1
-    read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
-    parse_run "$out"
-    check_ram "$board" "$v" || failed=1
-    spot_rows+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
-    check_counts "$board" "$v" "$frame $display $render $clears $geometry $raster" || failed=1
-  done
-done
-
-# Cluster culling of Spot (issue 11) on the M4F: Spot in cluster order
-# (baked/spot_clusters.rs), the baseline with every cluster drawn and the
-# three cluster tests; each frame bit-identical to the host's unculled
-# one (build.rs) and to host-checksums.txt, counts of record in
-# docs/embedded.md.
-cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
-cluster_rows=()
-target=thumbv7em-none-eabihf board=mps2-an386
-for v in "${cluster_variants[@]}"; do
-  step "$board ($target), Spot clusters: $v"
+# spot_run TARGET BOARD FEATURES KEY ROWS: builds and runs a Spot variant,
+# requires exit 0 and the checksum of host-checksums.txt's KEY, checks
+# its RAM and its counts of record, and appends its table row to the
+# array named ROWS. Returns 1 when the run itself failed (nothing to
+# check further).
+spot_run() {
+  local target=$1 board=$2 v=$3 key=$4
+  local -n table=$5
+  step "$board ($target), Spot: $v"
   out=$log/$board-${v//,/+}.txt
   set +e
   timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
@@ -369,25 +335,46 @@ for v in "${cluster_variants[@]}"; do
   if [ "$rc" -ne 0 ]; then
     echo "FAIL: $board $v exited $rc"
     failed=1
-    continue
+    return 1
   fi
   got=$(awk '$1 == "checksum" { print $2 }' "$out")
-  want=$(expected "${v%%,*}-clusters")
+  want=$(expected "$key")
   if [ -z "$want" ] || [ "$got" != "$want" ]; then
-    echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} (${v%%,*}-clusters)"
+    echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
     failed=1
   fi
-  case $v in *cull-*)
-    if ! grep -q 'skipped before transform [1-9]' "$out"; then
-      echo "FAIL: $board $v skipped no triangle"
-      failed=1
-    fi ;;
-  esac
   read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
   parse_run "$out"
   check_ram "$board" "$v" || failed=1
-  cluster_rows+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
+  table+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
   check_counts "$board" "$v" "$frame $display $render $clears $geometry $raster" || failed=1
+}
+
+spot_rows=()
+for b in "${boards[@]}"; do
+  read -r target board <<<"$b"
+  for v in "${spot_variants[@]}"; do
+    case $board in microbit) key=$v-microbit ;; *) key=$v ;; esac
+    spot_run "$target" "$board" "$v" "$key" spot_rows || continue
+    check_linked "$board" "$v" "$elf" || failed=1
+  done
+done
+
+# Cluster culling of Spot (issue 11) on the M4F: Spot in cluster order
+# (baked/spot_clusters.rs), the baseline with every cluster drawn and the
+# three cluster tests; each frame bit-identical to the host's unculled
+# one (build.rs) and to host-checksums.txt, counts of record in
+# docs/embedded.md.
+cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
+cluster_rows=()
+for v in "${cluster_variants[@]}"; do
+  spot_run thumbv7em-none-eabihf mps2-an386 "$v" "${v%%,*}-clusters" cluster_rows || continue
+  case $v in *cull-*)
+    if ! grep -q 'skipped before transform [1-9]' "$out"; then
+      echo "FAIL: mps2-an386 $v skipped no triangle"
+      failed=1
+    fi ;;
+  esac
 done
 
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
