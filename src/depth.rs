@@ -51,6 +51,19 @@ pub(crate) mod cmp {
     pub const GREATER_EQUAL: u8 = 3;
 }
 
+/// Marks the path it is on as rarely taken, so the span loops keep their
+/// common case (a pixel written) as straight-line code: `core::hint::cold_path`
+/// where the compiler has it (Rust 1.95 on, `build.rs`), nothing before.
+/// On the Cortex-M4F the four-cubes frame takes 9 k fewer instructions
+/// with it.
+#[inline(always)]
+fn cold() {
+    // Only compiled where `build.rs` found Rust 1.95 or later.
+    #[cfg(microraster_cold_path)]
+    #[allow(clippy::incompatible_msrv)]
+    core::hint::cold_path();
+}
+
 /// `new CMP old` for a [`cmp`] constant (resolved at compile time).
 #[inline(always)]
 pub(crate) fn passes<const CMP: u8, T: Ord>(new: T, old: T) -> bool {
@@ -280,18 +293,42 @@ fn z32_loop<W: DepthWord, C: Copy, const CMP: u8>(
     dz: u32,
     px: C,
 ) -> u32 {
-    let mut written = 0u32;
+    let n = c.len().min(d.len());
+    let (c, d) = (&mut c[..n], &mut d[..n]);
+    // Failures are counted (the rarer case on a front-to-back frame), and
+    // four pixels a turn with constant offsets.
+    let mut failed = 0u32;
     let mut z = z0;
+    let mut c4 = c.chunks_exact_mut(4);
+    let mut d4 = d.chunks_exact_mut(4);
+    for (cq, dq) in (&mut c4).zip(&mut d4) {
+        let z1 = z.wrapping_add(dz);
+        let z2 = z1.wrapping_add(dz);
+        let z3 = z2.wrapping_add(dz);
+        for (k, zk) in [z, z1, z2, z3].into_iter().enumerate() {
+            let (key, old) = (W::key_in_range(zk as u64), dq[k].key());
+            if passes::<CMP, _>(key, old) {
+                dq[k] = W::from_fixed_in_range(zk as u64);
+                cq[k] = px;
+            } else {
+                cold();
+                failed += 1;
+            }
+        }
+        z = z3.wrapping_add(dz);
+    }
+    let (c, d) = (c4.into_remainder(), d4.into_remainder());
     for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
         let (key, old) = (W::key_in_range(z as u64), (*dp).key());
         if passes::<CMP, _>(key, old) {
             *dp = W::from_fixed_in_range(z as u64);
             *cp = px;
-            written += 1;
+        } else {
+            failed += 1;
         }
         z = z.wrapping_add(dz);
     }
-    written
+    n as u32 - failed
 }
 
 /// `Z32` of a `Z32.F` value `z` (`F = frac`, clamped). Spans step `z` by
@@ -900,6 +937,42 @@ mod tests {
             // bits).
             unclamped_matches::<u32>(z0, dz, len, seed, k);
             unclamped_matches::<DepthF32>(z0, dz, len, seed, k);
+        }
+
+        /// The `Z32.0` loop (`u16` words: `z32_loop`, four pixels a turn,
+        /// failures counted, the rest one by one) against the
+        /// pixel-by-pixel loop, over every remainder length and every
+        /// mix of passing and failing pixels (stored words hashed, or all
+        /// near the span's depths so about half pass).
+        #[test]
+        fn z32_span_loop_equals_pixel_loop(
+            z0 in prop_oneof![0i64..1 << 32, (1i64 << 32) - (1 << 20)..1 << 32, 0i64..1 << 20],
+            dz in prop_oneof![-(1i64 << 24)..1 << 24, -4i64..4, -(1i64 << 31)..1 << 31],
+            len in 1usize..70,
+            seed in any::<u64>(),
+            k in 0u8..4,
+        ) {
+            unclamped_matches::<u16>(z0, dz, len, seed, k);
+            // Stored words within a few steps of the span's own.
+            let near = |n: u64| {
+                let h = (seed ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 61;
+                (z0 + (n as i64 + h as i64 - 4) * dz).clamp(0, u32::MAX as i64) as u32
+            };
+            if in_range_throughout(z0, dz, len, 0) {
+                let stored: std::vec::Vec<u16> = (0..len as u64).map(|n| u16::from_z32(near(n))).collect();
+                let (mut d_ref, mut c_ref) = (stored.clone(), std::vec![0u8; len]);
+                let func = [DepthFunc::Less, DepthFunc::LessEqual, DepthFunc::Greater, DepthFunc::GreaterEqual][k as usize % 4];
+                let want = flat_span_each(&mut d_ref[..], &mut c_ref, 0, len, z0, dz, func, true, 1u8);
+                let (mut d, mut c) = (stored, std::vec![0u8; len]);
+                let (z, step) = (z0 as u32, dz as u32);
+                let got = match func {
+                    DepthFunc::Less => span_z32::<u16, u8, { cmp::LESS }>(&mut c, &mut d, z, step, 1),
+                    DepthFunc::LessEqual => span_z32::<u16, u8, { cmp::LESS_EQUAL }>(&mut c, &mut d, z, step, 1),
+                    DepthFunc::Greater => span_z32::<u16, u8, { cmp::GREATER }>(&mut c, &mut d, z, step, 1),
+                    _ => span_z32::<u16, u8, { cmp::GREATER_EQUAL }>(&mut c, &mut d, z, step, 1),
+                };
+                prop_assert_eq!((got, &d, &c), (want, &d_ref, &c_ref));
+            }
         }
 
         /// `DepthF32` is `z / 2^48` truncated to an `f32` (against the
