@@ -295,16 +295,28 @@ fn z32_loop<W: DepthWord, C: Copy, const CMP: u8>(
 ) -> u32 {
     let n = c.len().min(d.len());
     let (c, d) = (&mut c[..n], &mut d[..n]);
-    // Failures are counted (the rarer case on a front-to-back frame), and
-    // four pixels a turn with constant offsets.
+    // Failures are counted (the rarer case on a front-to-back frame). The
+    // first `n mod 4` pixels go one by one, the rest four a turn at
+    // constant offsets, `z` stepped by multiples of `dz` (wrapping: the
+    // same integers as `z0 + k dz`).
     let mut failed = 0u32;
     let mut z = z0;
-    let mut c4 = c.chunks_exact_mut(4);
-    let mut d4 = d.chunks_exact_mut(4);
-    for (cq, dq) in (&mut c4).zip(&mut d4) {
-        let z1 = z.wrapping_add(dz);
-        let z2 = z1.wrapping_add(dz);
-        let z3 = z2.wrapping_add(dz);
+    let head = n % 4;
+    let (ch, c4) = c.split_at_mut(head);
+    let (dh, d4) = d.split_at_mut(head);
+    for (cp, dp) in ch.iter_mut().zip(dh.iter_mut()) {
+        let (key, old) = (W::key_in_range(z as u64), (*dp).key());
+        if passes::<CMP, _>(key, old) {
+            *dp = W::from_fixed_in_range(z as u64);
+            *cp = px;
+        } else {
+            failed += 1;
+        }
+        z = z.wrapping_add(dz);
+    }
+    let (dz2, dz3, dz4) = (dz.wrapping_mul(2), dz.wrapping_mul(3), dz.wrapping_mul(4));
+    for (cq, dq) in c4.chunks_exact_mut(4).zip(d4.chunks_exact_mut(4)) {
+        let (z1, z2, z3) = (z.wrapping_add(dz), z.wrapping_add(dz2), z.wrapping_add(dz3));
         for (k, zk) in [z, z1, z2, z3].into_iter().enumerate() {
             let (key, old) = (W::key_in_range(zk as u64), dq[k].key());
             if passes::<CMP, _>(key, old) {
@@ -315,18 +327,7 @@ fn z32_loop<W: DepthWord, C: Copy, const CMP: u8>(
                 failed += 1;
             }
         }
-        z = z3.wrapping_add(dz);
-    }
-    let (c, d) = (c4.into_remainder(), d4.into_remainder());
-    for (cp, dp) in c.iter_mut().zip(d.iter_mut()) {
-        let (key, old) = (W::key_in_range(z as u64), (*dp).key());
-        if passes::<CMP, _>(key, old) {
-            *dp = W::from_fixed_in_range(z as u64);
-            *cp = px;
-        } else {
-            failed += 1;
-        }
-        z = z.wrapping_add(dz);
+        z = z.wrapping_add(dz4);
     }
     n as u32 - failed
 }
@@ -939,8 +940,8 @@ mod tests {
             unclamped_matches::<DepthF32>(z0, dz, len, seed, k);
         }
 
-        /// The `Z32.0` loop (`u16` words: `z32_loop`, four pixels a turn,
-        /// failures counted, the rest one by one) against the
+        /// The `Z32.0` loop (`u16` words: `z32_loop`, `n mod 4` pixels one
+        /// by one, then four a turn, failures counted) against the
         /// pixel-by-pixel loop, over every remainder length and every
         /// mix of passing and failing pixels (stored words hashed, or all
         /// near the span's depths so about half pass).
