@@ -16,9 +16,10 @@ use common::HitCounter;
 use microraster::pixelcolor::Rgb888;
 use microraster::prelude::*;
 use microraster::{
-    Config, CullMode, Frame, Mat4, Mesh, MeshColors, RasterMode, SetupTriangle, StripRenderer,
-    TriangleId, Vec3,
+    Config, CullMode, Frame, Mat4, Mesh, MeshColors, SetupTriangle, TriangleId, Vec3,
 };
+#[cfg(feature = "clipless")]
+use microraster::{RasterMode, StripRenderer};
 
 /// Positions and triangles of a Wavefront OBJ (`v` and triangular `f`
 /// lines, `f a/b/c` indices taken from the first field).

@@ -235,9 +235,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DEG", value_parser = parse_fov, allow_hyphen_values = true)]
     pub fov: Option<f32>,
 
-    /// Image size in pixels.
-    #[arg(long, value_name = "WxH", default_value = "800x600", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Image size in pixels [default: the scene's, as `bench` takes it
+    /// (cubes 800x600, sphere 240x320, spots and house 320x240, the
+    /// others 1920x1080); 800x600 for --obj and --clip-tris].
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
 
     /// Worker threads.
     #[arg(long, value_name = "N", default_value_t = default_threads(), value_parser = parse_threads)]
@@ -394,17 +396,27 @@ impl RenderArgs {
 
     /// Image width in pixels.
     pub fn width(&self) -> u32 {
-        self.size.0
+        self.image_size().0
     }
 
     /// Image height in pixels.
     pub fn height(&self) -> u32 {
-        self.size.1
+        self.image_size().1
     }
 
     /// Width / height.
     pub fn aspect(&self) -> f32 {
-        self.size.0 as f32 / self.size.1 as f32
+        let (w, h) = self.image_size();
+        w as f32 / h as f32
+    }
+
+    /// `--size`, or the scene's default size (800x600 for a file).
+    pub fn image_size(&self) -> (u32, u32) {
+        match (self.size, self.obj.is_some() || self.clip_tris.is_some()) {
+            (Some(size), _) => size,
+            (None, true) => (800, 600),
+            (None, false) => crate::bench_scenes::default_size(&self.scene),
+        }
     }
 }
 
@@ -966,6 +978,24 @@ mod tests {
         Cli::command().debug_assert();
     }
 
+    /// `render` draws a scene at its own size unless `--size` says
+    /// otherwise (a file at 800x600).
+    #[test]
+    fn render_size_defaults_to_the_scene() {
+        let cases: [(&[&str], (u32, u32)); 6] = [
+            (&["--scene", "house"], (320, 240)),
+            (&["--scene", "spots"], (320, 240)),
+            (&["--scene", "sphere"], (240, 320)),
+            (&["--scene", "cubes"], (800, 600)),
+            (&["--obj", "m.obj"], (800, 600)),
+            (&["--scene", "house", "--size", "64x48"], (64, 48)),
+        ];
+        for (args, size) in cases {
+            let r = render(args).unwrap();
+            assert_eq!((r.width(), r.height()), size, "{args:?}");
+        }
+    }
+
     #[test]
     fn defaults() {
         let r = render(&[]).unwrap();
@@ -976,7 +1006,7 @@ mod tests {
         assert_eq!(r.eye, None);
         assert_eq!(r.target, None);
         assert_eq!(r.fov, None);
-        assert_eq!(r.size, (800, 600));
+        assert_eq!(r.size, None);
         assert_eq!((r.width(), r.height()), (800, 600));
         assert!((r.aspect() - 4.0 / 3.0).abs() < 1e-6);
         assert_eq!(r.threads, default_threads());
@@ -1027,7 +1057,7 @@ mod tests {
         assert_eq!(r.eye, Some([-1.0, 2.5, 3.0]));
         assert_eq!(r.target, Some([0.0, 0.0, -10.0]));
         assert_eq!(r.fov, Some(45.5));
-        assert_eq!(r.size, (640, 480));
+        assert_eq!(r.size, Some((640, 480)));
         assert_eq!(r.threads, 3);
         assert_eq!(r.strip_rows, 1);
         assert_eq!(r.cull, CullArg::None);
