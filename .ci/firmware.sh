@@ -366,7 +366,32 @@ done
 # one (build.rs) and to host-checksums.txt, counts of record in
 # docs/embedded.md.
 cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
+# check_sweep BOARD NAME "CULLED EVERY": a camera sweep's mean render
+# instructions a frame, culled and with every cluster drawn, against the
+# sweep table of docs/embedded.md (as check_counts).
+check_sweep() {
+  local board=$1 name=$2 now=$3 recorded
+  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+    '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $7, $8; exit }' "$record")
+  if [ -z "$recorded" ]; then
+    echo "FAIL: no sweep row for $board $name in docs/embedded.md"
+    return 1
+  fi
+  local labels=(culled every-cluster) i bad=0
+  read -r -a was <<<"$recorded"
+  read -r -a is <<<"$now"
+  for i in 0 1; do
+    if [ $(( is[i] * 100 )) -gt $(( was[i] * (100 + tolerance_pct) )) ] && [ $(( is[i] - was[i] )) -gt "$slack" ]; then
+      echo "FAIL: $board $name ${labels[i]} ${is[i]} instructions, over 1.0${tolerance_pct}x the recorded ${was[i]}"
+      bad=1
+    elif [ $(( is[i] * 100 )) -lt $(( was[i] * (100 - tolerance_pct) )) ] && [ $(( was[i] - is[i] )) -gt "$slack" ]; then
+      echo "note: $board $name ${labels[i]} ${is[i]}, below the recorded ${was[i]}: update docs/embedded.md"
+    fi
+  done
+  return "$bad"
+}
 cluster_rows=()
+sweep_rows=()
 for v in "${cluster_variants[@]}"; do
   spot_run thumbv7em-none-eabihf mps2-an386 "$v" "${v%%,*}-clusters" cluster_rows || continue
   case $v in *cull-*)
@@ -375,6 +400,17 @@ for v in "${cluster_variants[@]}"; do
       failed=1
     fi ;;
   esac
+  # The camera sweep: cameras round Spot, each frame drawn culled and with
+  # every cluster and compared on the board (a difference fails the run).
+  sweep=$(sed -nE 's/^sweep of ([0-9]+) cameras: skipped before transform ([0-9.]+) % \(([0-9.]+)-([0-9.]+) %\); render a frame ([0-9]+) culled, ([0-9]+) with every cluster \(([0-9.]+)x\)$/\1 \2 \3 \4 \5 \6 \7/p' "$out")
+  if [ -z "$sweep" ]; then
+    echo "FAIL: mps2-an386 $v printed no camera sweep"
+    failed=1
+    continue
+  fi
+  read -r cams mean lo hi culled every ratio <<<"$sweep"
+  sweep_rows+=("| mps2-an386 | $v (sweep) | $cams | $mean % | $lo-$hi % | $culled | $every | $ratio |")
+  check_sweep mps2-an386 "$v (sweep)" "$culled $every" || failed=1
 done
 
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
@@ -435,6 +471,11 @@ step "Spot, cluster culling on the M4F (the same table in docs/embedded.md and d
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${cluster_rows[@]}"
+
+step "Spot, cluster culling on the M4F, camera sweep (the same table in docs/embedded.md)"
+echo "| board | build | cameras | skipped before transform, mean | fewest-most | render a frame, culled | with every cluster | culled / every |"
+echo "|---|---|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${sweep_rows[@]}"
 
 step "configurations, the report's speed axis (cubes, set up once; the same table in docs/embedded.md)"
 echo "$config_header"

@@ -35,6 +35,16 @@ pub enum DisplayError {
     OutOfOrder,
 }
 
+/// A frame in progress, set aside ([`HashDisplay::save`]).
+#[derive(Clone, Copy, Default)]
+#[allow(dead_code)]
+pub struct Saved {
+    next_row: u32,
+    sum: FrameChecksum,
+    pushes: u32,
+    ticks: u64,
+}
+
 /// A `width x height` Rgb565 display that checksums the frame it is sent.
 pub struct HashDisplay {
     size: Size,
@@ -59,6 +69,24 @@ impl HashDisplay {
             clock,
             ticks: 0,
         }
+    }
+
+    /// The frame received so far (checksum state, rows, pushes, ticks),
+    /// to set aside while other frames go through the same display.
+    #[allow(dead_code)]
+    pub fn save(&self) -> Saved {
+        Saved {
+            next_row: self.next_row,
+            sum: self.sum,
+            pushes: self.pushes,
+            ticks: self.ticks,
+        }
+    }
+
+    /// Puts a saved frame back (a new frame: `Saved::default()`).
+    #[allow(dead_code)]
+    pub fn restore(&mut self, s: Saved) {
+        (self.next_row, self.sum, self.pushes, self.ticks) = (s.next_row, s.sum, s.pushes, s.ticks);
     }
 
     /// The hash of the frame, once every row has arrived.

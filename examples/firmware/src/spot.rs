@@ -21,6 +21,8 @@
 
 use crate::clock::Clock;
 use crate::display::HashDisplay;
+#[cfg(feature = "clusters")]
+use crate::display::Saved;
 use crate::spot_scene::{self, Draw, Model};
 use crate::{
     exit, ram_use, ratio, BOARD, CORE, HEIGHT, HOST_CHECKSUM, STRIP_LEN, STRIP_ROWS, WIDTH,
@@ -295,6 +297,7 @@ impl Draw for Strips<'_> {
                 same: again == drawn,
             }
         };
+
         Measured {
             written,
             setup_start: t0,
@@ -308,9 +311,109 @@ impl Draw for Strips<'_> {
     }
 }
 
+/// The cluster builds' camera sweep, drawn through the firmware's strip
+/// loop after the frame of record (its own call of the scene's `draw`, so
+/// its stack is not on top of the frame's).
+#[cfg(feature = "clusters")]
+struct SweepFrames<'a> {
+    config: Config,
+    color: &'a mut [Rgb565],
+    depth: &'a mut [u16],
+    display: &'a mut HashDisplay,
+}
+
+#[cfg(feature = "clusters")]
+impl Draw for SweepFrames<'_> {
+    type Out = Sweep;
+
+    fn draw<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
+        self,
+        mesh: &Mesh<'_, A>,
+        fragment: F,
+    ) -> Sweep {
+        let SweepFrames {
+            config,
+            color,
+            depth,
+            display,
+        } = self;
+        // The sweep's frames go through the same display, the frame of
+        // record's checksum set aside.
+        let saved = display.save();
+        let mut s = Sweep::default();
+        let set = cluster_set();
+        for k in 0..spot_scene::SWEEP {
+            let mvp = spot_scene::sweep_mvp(WIDTH, HEIGHT, k);
+            let eye = cluster_eye(&mvp, &config);
+            let mut skipped = 0;
+            set.visit(eye.as_ref(), None, CULL.unwrap_or_default(), |v| {
+                if let Visit::Cull(a, b, _) = v {
+                    skipped += triangles(a, b);
+                }
+            });
+            // Culled: the eye, the walk and every strip; then the same
+            // frame with every cluster drawn. Pushes excluded.
+            let mut sums = [None; 2];
+            let mut ticks = [0; 2];
+            for (i, culled) in [true, false].into_iter().enumerate() {
+                display.restore(Saved::default());
+                let t = display.clock.now();
+                let drawn = if culled {
+                    drawn_clusters(cluster_eye(&mvp, &config).as_ref())
+                } else {
+                    drawn_clusters(None)
+                };
+                let ok = frame(config, &mvp, &drawn, color, depth, display, mesh, fragment);
+                ticks[i] = display.clock.now() - t - display.ticks;
+                sums[i] = display.checksum().filter(|_| ok.is_ok());
+            }
+            s.identical &= sums[0].is_some() && sums[0] == sums[1];
+            s.skipped += skipped;
+            s.min_skipped = s.min_skipped.min(skipped);
+            s.max_skipped = s.max_skipped.max(skipped);
+            s.culled += ticks[0];
+            s.unculled += ticks[1];
+        }
+        display.restore(saved);
+        s
+    }
+}
+
+/// The cluster builds' camera sweep ([`spot_scene::SWEEP`] cameras round
+/// Spot), each frame drawn culled and with every cluster, and compared.
+#[cfg(feature = "clusters")]
+struct Sweep {
+    /// Triangles skipped before transform, summed over the cameras, and
+    /// the fewest and most at one camera.
+    skipped: u64,
+    min_skipped: u64,
+    max_skipped: u64,
+    /// Ticks of the culled frames (eye, walk, strips; pushes excluded)
+    /// and of the same frames with every cluster drawn.
+    culled: u64,
+    unculled: u64,
+    /// Whether every culled frame's checksum equals its unculled one's.
+    identical: bool,
+}
+
+#[cfg(feature = "clusters")]
+impl Default for Sweep {
+    fn default() -> Self {
+        Sweep {
+            skipped: 0,
+            min_skipped: u64::MAX,
+            max_skipped: 0,
+            culled: 0,
+            unculled: 0,
+            identical: true,
+        }
+    }
+}
+
 /// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
 /// push the rows. The pixels written.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
     config: Config,
     mvp: &Mat4,
@@ -466,6 +569,22 @@ fn main() -> ! {
             exit(false)
         }
     };
+    #[cfg(feature = "clusters")]
+    let sweep = {
+        let frames = SweepFrames {
+            config,
+            color: &mut COLOR[..],
+            depth: &mut DEPTH[..],
+            display: &mut display,
+        };
+        match spot_scene::draw(&model, frames) {
+            Ok(s) => s,
+            Err(e) => {
+                hprintln!("FAIL: sweep: {}", e);
+                exit(false)
+            }
+        }
+    };
     let written = match m.written {
         Ok(w) => w,
         Err(e) => {
@@ -570,6 +689,33 @@ fn main() -> ! {
         }
         if !c.same {
             hprintln!("FAIL: the cluster test decided differently the second time");
+            exit(false)
+        }
+        let s = &sweep;
+        let n = spot_scene::SWEEP as u64;
+        let (a, b) = ratio(s.skipped * 100, total * n);
+        let (lo, lb) = ratio(s.min_skipped * 100, total);
+        let (hi, hb) = ratio(s.max_skipped * 100, total);
+        let (culled, unculled) = (instr(s.culled) / n, instr(s.unculled) / n);
+        let q = (culled * 1000 + unculled / 2) / unculled.max(1);
+        hprintln!(
+            "sweep of {} cameras: skipped before transform {}.{} % ({}.{}-{}.{} %); render a frame {} culled, {} with every cluster ({}.{:03}x)",
+            n,
+            a,
+            b,
+            lo,
+            lb,
+            hi,
+            hb,
+            culled,
+            unculled,
+            q / 1000,
+            q % 1000
+        );
+        if !s.identical {
+            hprintln!(
+                "FAIL: a sweep frame culled differs from the same frame with every cluster drawn"
+            );
             exit(false)
         }
     }

@@ -108,6 +108,33 @@ pub fn mvp(width: u32, height: u32) -> Mat4 {
         * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0))
 }
 
+/// Cameras of the cluster builds' sweep: eyes on the circle through
+/// [`EYE`] about the vertical axis through [`TARGET`], 45 degrees apart,
+/// at [`EYE`]'s height; the first is [`EYE`] itself.
+#[allow(dead_code)]
+pub const SWEEP: usize = 8;
+
+/// Object to clip space from the sweep's camera `k` (see [`SWEEP`]).
+#[allow(dead_code)]
+pub fn sweep_mvp(width: u32, height: u32, k: usize) -> Mat4 {
+    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
+    const DIRS: [(f32, f32); SWEEP] = [
+        (0.0, -1.0),
+        (H, -H),
+        (1.0, 0.0),
+        (H, H),
+        (0.0, 1.0),
+        (-H, H),
+        (-1.0, 0.0),
+        (-H, -H),
+    ];
+    let (sx, sz) = DIRS[k % SWEEP];
+    let r = TARGET.z - EYE.z;
+    let eye = Vec3::new(TARGET.x + r * sx, EYE.y, TARGET.z + r * sz);
+    Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
+        * Mat4::look_at(eye, TARGET, Vec3::new(0.0, 1.0, 0.0))
+}
+
 /// Ambient plus one white-ish key light above the viewer's left, in
 /// object space (the viewer looks along +z, so its left is +x).
 #[allow(dead_code)]
