@@ -128,17 +128,24 @@ check_ram() {
 # measurement's granularity, `slack` instructions) over the row recorded
 # in docs/embedded.md (a missing row fails too).
 check_counts() {
-  local board=$1 name=$2 now=$3 recorded
-  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+  local recorded
+  recorded=$(awk -F'|' -v b=" $1 " -v f=" $2 " \
     '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $9, $10, $11, $12, $13, $14; exit }' "$record")
+  compare_counts "$1" "$2" "" "frame display-push render clears geometry rasterization" "$recorded" "$3"
+}
+# compare_counts BOARD NAME KIND "LABELS" "RECORDED" "NOW": the check of
+# check_counts, check_config and check_sweep, count by count (KIND names
+# the row in the message: "", "configuration " or "sweep ").
+compare_counts() {
+  local board=$1 name=$2 kind=$3 labels recorded=$5 now=$6 i bad=0
   if [ -z "$recorded" ]; then
-    echo "FAIL: no row for $board $name in docs/embedded.md"
+    echo "FAIL: no ${kind}row for $board $name in docs/embedded.md"
     return 1
   fi
-  local labels=(frame display-push render clears geometry rasterization) i=0 bad=0
+  read -r -a labels <<<"$4"
   read -r -a was <<<"$recorded"
   read -r -a is <<<"$now"
-  for i in 0 1 2 3 4 5; do
+  for i in "${!labels[@]}"; do
     # SysTick ticks are 40 (62.5 on the micro:bit) instructions and the
     # clears are one strip's count times the strips, so a count can move
     # by a few thousand without any code change: that much is slack too.
@@ -256,25 +263,10 @@ config_rows=()
 # check_config BOARD LABEL "frame render raster": the 1 % check of
 # check_counts against docs/embedded.md's configuration table.
 check_config() {
-  local board=$1 name=$2 now=$3 recorded
-  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+  local recorded
+  recorded=$(awk -F'|' -v b=" $1 " -v f=" $2 " \
     '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $4, $5, $6; exit }' "$record")
-  if [ -z "$recorded" ]; then
-    echo "FAIL: no configuration row for $board $name in docs/embedded.md"
-    return 1
-  fi
-  local labels=(frame render rasterization) i bad=0
-  read -r -a was <<<"$recorded"
-  read -r -a is <<<"$now"
-  for i in 0 1 2; do
-    if [ $(( is[i] * 100 )) -gt $(( was[i] * (100 + tolerance_pct) )) ] && [ $(( is[i] - was[i] )) -gt "$slack" ]; then
-      echo "FAIL: $board $name ${labels[i]} ${is[i]} instructions, over 1.0${tolerance_pct}x the recorded ${was[i]}"
-      bad=1
-    elif [ $(( is[i] * 100 )) -lt $(( was[i] * (100 - tolerance_pct) )) ] && [ $(( was[i] - is[i] )) -gt "$slack" ]; then
-      echo "note: $board $name ${labels[i]} ${is[i]}, below the recorded ${was[i]}: update docs/embedded.md"
-    fi
-  done
-  return "$bad"
+  compare_counts "$1" "$2" "configuration " "frame render rasterization" "$recorded" "$3"
 }
 for b in "${config_boards[@]}"; do
   read -r target board <<<"$b"
@@ -370,25 +362,10 @@ cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volum
 # instructions a frame, culled and with every cluster drawn, against the
 # sweep table of docs/embedded.md (as check_counts).
 check_sweep() {
-  local board=$1 name=$2 now=$3 recorded
-  recorded=$(awk -F'|' -v b=" $board " -v f=" $name " \
+  local recorded
+  recorded=$(awk -F'|' -v b=" $1 " -v f=" $2 " \
     '$2 == b && $3 == f { gsub(/[ *,]/, ""); print $7, $8; exit }' "$record")
-  if [ -z "$recorded" ]; then
-    echo "FAIL: no sweep row for $board $name in docs/embedded.md"
-    return 1
-  fi
-  local labels=(culled every-cluster) i bad=0
-  read -r -a was <<<"$recorded"
-  read -r -a is <<<"$now"
-  for i in 0 1; do
-    if [ $(( is[i] * 100 )) -gt $(( was[i] * (100 + tolerance_pct) )) ] && [ $(( is[i] - was[i] )) -gt "$slack" ]; then
-      echo "FAIL: $board $name ${labels[i]} ${is[i]} instructions, over 1.0${tolerance_pct}x the recorded ${was[i]}"
-      bad=1
-    elif [ $(( is[i] * 100 )) -lt $(( was[i] * (100 - tolerance_pct) )) ] && [ $(( was[i] - is[i] )) -gt "$slack" ]; then
-      echo "note: $board $name ${labels[i]} ${is[i]}, below the recorded ${was[i]}: update docs/embedded.md"
-    fi
-  done
-  return "$bad"
+  compare_counts "$1" "$2" "sweep " "culled every-cluster" "$recorded" "$3"
 }
 cluster_rows=()
 sweep_rows=()
