@@ -96,6 +96,9 @@ trait EdgeInt:
     fn unbiased<R: Real>(self, bias: i64) -> R;
     /// `self - bias` as `f32`.
     fn unbiased_f32(self, bias: i64) -> f32;
+    /// `self` as `R` (from `i32` where `Self` is: the same value, rounded
+    /// the same way, without `i64`'s library call on 32-bit cores).
+    fn real<R: Real>(self) -> R;
 }
 
 macro_rules! impl_edge_int {
@@ -105,6 +108,7 @@ macro_rules! impl_edge_int {
             const ONE: $t = 1;
             #[inline(always)]
             fn narrow(v: i64) -> $t {
+                debug_assert!(<$t>::try_from(v).is_ok(), "{v} does not fit");
                 v as $t
             }
             #[inline(always)]
@@ -122,6 +126,10 @@ macro_rules! impl_edge_int {
             #[inline(always)]
             fn unbiased_f32(self, bias: i64) -> f32 {
                 (self - bias as $t) as f32
+            }
+            #[inline(always)]
+            fn real<R: Real>(self) -> R {
+                R::$from(self)
             }
         }
     };
@@ -555,12 +563,14 @@ impl<R: Real, const N: usize> Shader<R, N> {
     ) -> Self {
         let (mut k1, mut k2, mut dz) = (R::ZERO, R::ZERO, R::ZERO);
         if D::ENABLED {
-            let inv_area = R::from_i64(t.area).recip();
+            // Twice the area fits `T` (for `i32`: it is at most the square
+            // of the span bound, as `EDGE32_SPAN` proves), as the steps do;
+            // converted from `T`, they are the same values as from `i64`.
+            let inv_area = T::narrow(t.area).real::<R>().recip();
             let z0 = t.z[0] as i64;
             k1 = R::from_i64(t.z[1] as i64 - z0) * inv_area;
             k2 = R::from_i64(t.z[2] as i64 - z0) * inv_area;
-            dz = k1 * R::from_i64(edges[1].step_x.widen())
-                + k2 * R::from_i64(edges[2].step_x.widen());
+            dz = k1 * edges[1].step_x.real::<R>() + k2 * edges[2].step_x.real::<R>();
         }
         let smooth = C::SHADED && t.smooth;
         let mut dv = [0.0f32; N];

@@ -1122,6 +1122,32 @@ fn edge32_limit_tri() -> impl Strategy<Value = [SubPt; 3]> {
         })
 }
 
+/// The same triangle drawn with a `u16` and a `u32` depth buffer (which
+/// sets up depth from the triangle's area and edge steps, narrowed to
+/// `i32` on the fast path: the narrowing's debug assertion and the
+/// overflow checks watch it) covers the pixels it covers without one.
+fn check_depth_coverage<const S: u32>(config: Config, pos: [Vec4; 3]) -> Result<(), TestCaseError> {
+    let n = (config.width * config.height) as usize;
+    let plain = coverage::<S>(config, pos);
+    let (ids16, ids32) = with_frame::<S, _>(config, &[pos], |frame| {
+        let mut ids16 = vec![TriangleId(0); n];
+        let mut z16 = vec![u16::MAX; n];
+        frame
+            .render_rows(0, config.height, &mut ids16[..], &mut z16[..])
+            .expect("valid rows");
+        let mut ids32 = vec![TriangleId(0); n];
+        let mut z32 = vec![u32::MAX; n];
+        frame
+            .render_rows(0, config.height, &mut ids32[..], &mut z32[..])
+            .expect("valid rows");
+        (ids16, ids32)
+    });
+    let covered = |ids: Vec<TriangleId>| ids.into_iter().map(|t| t.0 != 0).collect::<Vec<_>>();
+    prop_assert_eq!(covered(ids16), plain.clone(), "u16 depth");
+    prop_assert_eq!(covered(ids32), plain, "u32 depth");
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(cases(1024))]
 
@@ -1140,9 +1166,11 @@ proptest! {
             if s == 8 {
                 prop_assume!(snap_tri::<8>(&pos, w, h) == Some(vs));
                 check_coverage::<8>(config_nocull(w, h), pos)?;
+                check_depth_coverage::<8>(config_nocull(w, h), pos)?;
             } else {
                 prop_assume!(snap_tri::<4>(&pos, w, h) == Some(vs));
                 check_coverage::<4>(config_nocull(w, h), pos)?;
+                check_depth_coverage::<4>(config_nocull(w, h), pos)?;
             }
         }
     }
