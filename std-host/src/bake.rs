@@ -435,8 +435,22 @@ pub fn bake_source(
     source_label: &str,
     opts: &BakeOptions,
 ) -> Result<(String, BakeReport), String> {
-    check_texture_size(opts.texture_size)?;
     let label = source_label;
+    check_bakeable(mesh, label, opts)?;
+    let decimated = decimated_as_asked(mesh, opts).map_err(|e| format!("{label}: {e}"))?;
+    bake_decimated(
+        decimated.as_ref().unwrap_or(mesh),
+        mesh.indices.len(),
+        name,
+        label,
+        opts,
+    )
+}
+
+/// What [`bake_source`] refuses before it decimates: a texture size that
+/// is not a power of two in range, and non-finite positions.
+fn check_bakeable(mesh: &ShadedMesh, label: &str, opts: &BakeOptions) -> Result<(), String> {
+    check_texture_size(opts.texture_size)?;
     let bad = mesh
         .positions
         .iter()
@@ -447,15 +461,24 @@ pub fn bake_source(
             "{label}: {bad} vertex positions are NaN or infinite; firmware data must be finite"
         ));
     }
-    let source_triangles = mesh.indices.len();
-    let decimated;
-    let mesh = match opts.max_triangles {
-        Some(n) => {
-            decimated = decimate(mesh, n as usize).map_err(|e| format!("{label}: {e}"))?;
-            &decimated
-        }
-        None => mesh,
-    };
+    Ok(())
+}
+
+/// `mesh` decimated to `opts.max_triangles`, or `None` without a limit.
+fn decimated_as_asked(mesh: &ShadedMesh, opts: &BakeOptions) -> Result<Option<ShadedMesh>, String> {
+    opts.max_triangles
+        .map(|n| decimate(mesh, n as usize))
+        .transpose()
+}
+
+/// [`bake_source`] of a mesh already decimated (from `source_triangles`).
+fn bake_decimated(
+    mesh: &ShadedMesh,
+    source_triangles: usize,
+    name: &str,
+    label: &str,
+    opts: &BakeOptions,
+) -> Result<(String, BakeReport), String> {
     if mesh.materials.len() > 256 {
         return Err(format!(
             "{label}: {} materials; a bake holds at most 256 (TRIANGLE_MATERIAL is u8)",
@@ -695,14 +718,16 @@ pub fn cluster_source(
     name: &str,
     opts: &BakeOptions,
 ) -> Result<(String, ClusterBakeReport), String> {
-    let decimated;
-    let mesh = match opts.max_triangles {
-        Some(n) => {
-            decimated = decimate(mesh, n as usize)?;
-            &decimated
-        }
-        None => mesh,
-    };
+    let decimated = decimated_as_asked(mesh, opts)?;
+    cluster_decimated(decimated.as_ref().unwrap_or(mesh), name, opts)
+}
+
+/// [`cluster_source`] of a mesh already decimated.
+fn cluster_decimated(
+    mesh: &ShadedMesh,
+    name: &str,
+    opts: &BakeOptions,
+) -> Result<(String, ClusterBakeReport), String> {
     let positions: Vec<microraster::Vec3> = mesh
         .positions
         .iter()
@@ -846,9 +871,13 @@ pub fn bake_files(
     let mesh = obj::load_obj_shaded(&opts.model, opts.texture.as_deref())?;
     let name = module_name(&opts.model);
     let label = opts.model.display().to_string();
-    let (src, report) = bake_source(&mesh, &name, &label, opts)?;
+    // Checked and decimated once for both files.
+    check_bakeable(&mesh, &label, opts)?;
+    let decimated = decimated_as_asked(&mesh, opts).map_err(|e| format!("{label}: {e}"))?;
+    let baked = decimated.as_ref().unwrap_or(&mesh);
+    let (src, report) = bake_decimated(baked, mesh.indices.len(), &name, &label, opts)?;
     let clustered = if clusters {
-        Some(cluster_source(&mesh, &name, opts).map_err(|e| format!("{label}: {e}"))?)
+        Some(cluster_decimated(baked, &name, opts).map_err(|e| format!("{label}: {e}"))?)
     } else {
         None
     };
