@@ -546,6 +546,19 @@ fn small_key<D: DepthBuffer + ?Sized, R: Real>(z: R) -> u32 {
     }
 }
 
+/// `z1 - z0` (`Z32` units, exact in `i64`) as `R`: converted from `i32`
+/// where it fits (most triangles: their depths are close), the same value
+/// as the `i64` conversion, which is a library call on 32-bit cores.
+#[inline(always)]
+fn z_difference<R: Real>(z0: u32, z1: u32) -> R {
+    let d = z1.wrapping_sub(z0) as i32;
+    if (z1 >= z0) == (d >= 0) {
+        R::from_i32(d)
+    } else {
+        R::from_i64(z1 as i64 - z0 as i64)
+    }
+}
+
 /// Per-triangle constants for shading a covered pixel.
 struct Shader<R, const N: usize> {
     /// `Z0`.
@@ -585,9 +598,8 @@ impl<R: Real, const N: usize> Shader<R, N> {
             // of the span bound, as `EDGE32_SPAN` proves), as the steps do;
             // converted from `T`, they are the same values as from `i64`.
             let inv_area = T::narrow(t.area).real::<R>().recip();
-            let z0 = t.z[0] as i64;
-            k1 = R::from_i64(t.z[1] as i64 - z0) * inv_area;
-            k2 = R::from_i64(t.z[2] as i64 - z0) * inv_area;
+            k1 = z_difference::<R>(t.z[0], t.z[1]) * inv_area;
+            k2 = z_difference::<R>(t.z[0], t.z[2]) * inv_area;
             dz = k1 * edges[1].step_x.real::<R>() + k2 * edges[2].step_x.real::<R>();
         }
         let smooth = C::SHADED && t.smooth;
@@ -1256,6 +1268,19 @@ mod tests {
         ) {
             let snap = |v: [i32; 3]| if coarse { v.map(|c| c & !0x3ff) } else { v };
             check_walk::<i32>(snap(x), snap(y))?;
+        }
+
+        /// `z_difference` converts the exact difference, by either route:
+        /// the same `f32` and `f64` as from `i64`, on both sides of the
+        /// `i32` range.
+        #[test]
+        fn z_difference_is_the_i64_conversion(
+            z0 in prop_oneof![any::<u32>(), 0u32..4, u32::MAX - 3..=u32::MAX, (1u32 << 31) - 2..(1 << 31) + 2],
+            z1 in prop_oneof![any::<u32>(), 0u32..4, u32::MAX - 3..=u32::MAX, (1u32 << 31) - 2..(1 << 31) + 2],
+        ) {
+            let d = z1 as i64 - z0 as i64;
+            prop_assert_eq!(z_difference::<f32>(z0, z1).to_bits(), (d as f32).to_bits());
+            prop_assert_eq!(z_difference::<f64>(z0, z1).to_bits(), (d as f64).to_bits());
         }
 
         /// `i64` edges: vertices spanning up to 2^22 subpixel units.
