@@ -93,9 +93,9 @@ trait EdgeInt:
     /// `self - bias` (the unbiased edge value, which fits `Self`: see
     /// [`EDGE32_SPAN`]) as `R`, converted from `i32` where `Self` is
     /// (one instruction on an FPU, where `i64` takes a library call).
-    fn unbiased<R: Real>(self, bias: i64) -> R;
+    fn unbiased<R: Real>(self, bias: i32) -> R;
     /// `self - bias` as `f32`.
-    fn unbiased_f32(self, bias: i64) -> f32;
+    fn unbiased_f32(self, bias: i32) -> f32;
     /// `self` as `R` (from `i32` where `Self` is: the same value, rounded
     /// the same way, without `i64`'s library call on 32-bit cores).
     fn real<R: Real>(self) -> R;
@@ -124,11 +124,11 @@ macro_rules! impl_edge_int {
                 v as $t
             }
             #[inline(always)]
-            fn unbiased<R: Real>(self, bias: i64) -> R {
+            fn unbiased<R: Real>(self, bias: i32) -> R {
                 R::$from(self - bias as $t)
             }
             #[inline(always)]
-            fn unbiased_f32(self, bias: i64) -> f32 {
+            fn unbiased_f32(self, bias: i32) -> f32 {
                 (self - bias as $t) as f32
             }
             #[inline(always)]
@@ -197,7 +197,7 @@ struct Edge<T> {
     /// Change per row (`(xb - xa) << S`).
     step_y: T,
     /// 0 for a top or left edge, -1 otherwise.
-    bias: i64,
+    bias: i32,
 }
 
 impl<T: EdgeInt> Edge<T> {
@@ -214,7 +214,7 @@ impl<T: EdgeInt> Edge<T> {
         let top_left = dy < 0 || (dy == 0 && dx > 0);
         let bias = if top_left { 0 } else { -1 };
         Edge {
-            row: T::edge_value(dx, py - ya as i64, dy, px - xa as i64, bias),
+            row: T::edge_value(dx, py - ya as i64, dy, px - xa as i64, bias as i64),
             step_x: T::narrow(-dy << S),
             step_y: T::narrow(dx << S),
             bias,
@@ -572,7 +572,7 @@ struct Shader<R, const N: usize> {
     /// (saturating).
     dz_fixed: i64,
     /// Unbiased edge value = biased value - bias.
-    bias: [i64; 3],
+    bias: [i32; 3],
     /// Varying numerators' and the denominator's change per pixel.
     dv: [f32; N],
     dw: f32,
