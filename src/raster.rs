@@ -782,24 +782,22 @@ fn draw_in<
     if row_first > row_last || strip.y1 == 0 {
         return 0;
     }
-    let half = 1i64 << (S - 1);
-    let px = ((t.min_x as i64) << S) + half;
-    let py = ((row_first as i64) << S) + half;
-    let (x, y) = (t.x, t.y);
-    // Edge k is opposite vertex k: from vertex k+1 to vertex k+2.
-    let mut edges: [Edge<T>; 3] = [
-        Edge::new::<S>(x[1], y[1], x[2], y[2], px, py),
-        Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
-        Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
-    ];
-    let shader = Shader::<R, N>::new::<C, D, T>(t, &edges);
+    let smooth = C::SHADED && t.smooth;
     // A flat triangle's colour in the output format, once per strip.
-    let flat = if shader.smooth {
+    let flat = if smooth {
         C::from_fragment(t.flat, t.id)
     } else {
         C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id)
     };
-    if (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1 {
+    let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
+    if !smooth && !crosses && t.max_x - t.min_x >= SMALL_WIDTH {
+        // Flat spans, the most common case: their loop sets up its own
+        // edges and depth plane, so none of it is handed over.
+        return flat_rows::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat);
+    }
+    let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
+    let shader = Shader::<R, N>::new::<C, D, T>(t, &edges);
+    if crosses {
         // The box crosses the window's left or right side (tiles only).
         return window_rows::<N, C, D, F, R, T>(
             t,
@@ -870,7 +868,8 @@ fn draw_in<
         return written;
     }
 
-    if shader.smooth {
+    // Smooth spans (flat ones took `flat_rows` above).
+    {
         let mut spans = RowSpans::new(&edges, max_n);
         for _ in row_first..=row_last {
             if let Some((lo, hi)) = spans.span(&edges) {
@@ -899,20 +898,27 @@ fn draw_in<
             }
             base += strip.width;
         }
-        return written;
+        written
     }
-    // Flat: no varyings to step, so the rows take a loop of their own
-    // with only the depth state live (out of line, its registers are
-    // not the smooth path's).
-    flat_rows::<N, C, D, R, T>(
-        edges,
-        &shader,
-        row_last - row_first + 1,
-        (base, t.z),
-        max_n,
-        strip,
-        flat,
-    )
+}
+
+/// The triangle's three edge functions at the centre of the first column
+/// of its box on row `row`. Edge `k` is opposite vertex `k`: from vertex
+/// `k + 1` to vertex `k + 2`.
+#[inline(always)]
+fn edges_at<const S: u32, const N: usize, T: EdgeInt>(
+    t: &SetupTriangle<N>,
+    row: u32,
+) -> [Edge<T>; 3] {
+    let half = 1i64 << (S - 1);
+    let px = ((t.min_x as i64) << S) + half;
+    let py = ((row as i64) << S) + half;
+    let (x, y) = (t.x, t.y);
+    [
+        Edge::new::<S>(x[1], y[1], x[2], y[2], px, py),
+        Edge::new::<S>(x[2], y[2], x[0], y[0], px, py),
+        Edge::new::<S>(x[0], y[0], x[1], y[1], px, py),
+    ]
 }
 
 /// [`draw_in`] for a triangle whose box crosses the window's left or
@@ -1072,16 +1078,32 @@ fn window_rows<
 /// per row the exact span, its depth start from the exact edge values,
 /// then the depth buffer's flat-span loop. The same pixels and depths as
 /// the smooth path's spans (the same `Z32.F` steps from the same start).
+///
+/// Out of line, with only the depth state live in its rows (not the
+/// smooth path's registers), and it sets up the edges and the depth plane
+/// itself from the triangle: nothing but the triangle, its rows and its
+/// colour is handed over.
 #[inline(never)]
-fn flat_rows<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
-    mut edges: [Edge<T>; 3],
-    shader: &Shader<R, N>,
-    rows: u32,
-    (mut base, z): (usize, [u32; 3]),
-    max_n: usize,
+fn flat_rows<
+    const S: u32,
+    const N: usize,
+    C: PixelFormat,
+    D: DepthBuffer + ?Sized,
+    R: Real,
+    T: EdgeInt,
+>(
+    t: &SetupTriangle<N>,
+    (row_first, row_last): (u32, u32),
     strip: &mut Strip<'_, C, D>,
     px: C,
 ) -> u32 {
+    let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
+    let shader = &Shader::<R, N>::new::<C, D, T>(t, &edges);
+    let rows = row_last - row_first + 1;
+    let max_n = (t.max_x - t.min_x) as usize;
+    let z = t.z;
+    let mut base =
+        (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
     if D::ENABLED && D::FRAC == 0 && strip.depth_write && z_never_clamps(z, max_n) {
         let cmp = match strip.depth_func {
             DepthFunc::Less => Some(cmp::LESS),
