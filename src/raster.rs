@@ -588,6 +588,7 @@ struct Acc<R, const N: usize> {
 }
 
 impl<R: Real, const N: usize> Shader<R, N> {
+    #[inline(always)]
     fn new<C: PixelFormat, D: DepthBuffer + ?Sized, T: EdgeInt>(
         t: &SetupTriangle<N>,
         edges: &[Edge<T>; 3],
