@@ -555,6 +555,12 @@ fn z_difference<R: Real>(z0: u32, z1: u32) -> R {
         // One instruction from `i64` there: no test.
         return R::from_i64(z1 as i64 - z0 as i64);
     }
+    z_difference_via_i32(z0, z1)
+}
+
+/// [`z_difference`] on 32-bit cores (tested on every target).
+#[inline(always)]
+fn z_difference_via_i32<R: Real>(z0: u32, z1: u32) -> R {
     let d = z1.wrapping_sub(z0) as i32;
     if (z1 >= z0) == (d >= 0) {
         R::from_i32(d)
@@ -1308,7 +1314,8 @@ mod tests {
             check_walk::<i32>(snap(x), snap(y))?;
         }
 
-        /// `z_difference` converts the exact difference, by either route:
+        /// `z_difference` converts the exact difference, by either route
+        /// (the 32-bit cores' one, `z_difference_via_i32`, tested here too):
         /// the same `f32` and `f64` as from `i64`, on both sides of the
         /// `i32` range.
         #[test]
@@ -1318,7 +1325,9 @@ mod tests {
         ) {
             let d = z1 as i64 - z0 as i64;
             prop_assert_eq!(z_difference::<f32>(z0, z1).to_bits(), (d as f32).to_bits());
+            prop_assert_eq!(z_difference_via_i32::<f32>(z0, z1).to_bits(), (d as f32).to_bits());
             prop_assert_eq!(z_difference::<f64>(z0, z1).to_bits(), (d as f64).to_bits());
+            prop_assert_eq!(z_difference_via_i32::<f64>(z0, z1).to_bits(), (d as f64).to_bits());
         }
 
         /// `i64` edges: vertices spanning up to 2^22 subpixel units.
