@@ -793,21 +793,21 @@ fn draw_in<
     if row_first > row_last || strip.y1 == 0 {
         return 0;
     }
-    let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
-    if EARLY_FLAT && !(C::SHADED && t.smooth) && !crosses && t.max_x - t.min_x >= SMALL_WIDTH {
-        // Flat spans, the most common case: their loop sets up its own
-        // edges and depth plane, so none of it is handed over.
-        let flat = C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id);
-        return flat_rows::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat);
-    }
-    let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
-    let shader = Shader::<R, N>::new::<C, D, T>(t, &edges);
+    let smooth = C::SHADED && t.smooth;
     // A flat triangle's colour in the output format, once per strip.
-    let flat = if shader.smooth {
+    let flat = if smooth {
         C::from_fragment(t.flat, t.id)
     } else {
         C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id)
     };
+    let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
+    if EARLY_FLAT && !smooth && !crosses && t.max_x - t.min_x >= SMALL_WIDTH {
+        // Flat spans, the most common case: their loop sets up its own
+        // edges and depth plane, so none of it is handed over.
+        return flat_rows::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat);
+    }
+    let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
+    let shader = Shader::<R, N>::new::<C, D, T>(t, &edges);
     if crosses {
         // The box crosses the window's left or right side (tiles only).
         return window_rows::<N, C, D, F, R, T>(
