@@ -45,7 +45,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 use crate::config::{CullMode, Error, FrontFace};
-use crate::math::{Mat4, Vec3};
+use crate::math::{Mat4, Vec3, Vec4};
 use crate::mesh::BoundingSphere;
 
 /// The least sine of the angle past edge-on at which a skipped triangle
@@ -1025,6 +1025,8 @@ impl ClusterNode {
 pub struct Detail {
     view: Projection,
     pixels: f32,
+    /// The frame's matrix, for the centre of [`Detail::screen_box`].
+    mvp: Mat4,
 }
 
 impl Detail {
@@ -1037,6 +1039,7 @@ impl Detail {
         Some(Detail {
             view: Projection::new(mvp, config)?,
             pixels: f32::from(config.detail),
+            mvp: *mvp,
         })
     }
 
@@ -1058,6 +1061,40 @@ impl Detail {
     pub fn drops(&self, sphere: &BoundingSphere) -> bool {
         self.extent(sphere).is_some_and(|d| d < self.pixels)
     }
+
+    /// The box drawn in place of a dropped `sphere` when the mesh's
+    /// attributes give a fill ([`Attributes::detail_fill`]): a
+    /// screen-aligned rectangle about the projection of the centre, at the
+    /// centre's depth, as wide and as high as the bound of
+    /// [`Detail::extent`] along each axis (so it covers the sphere's
+    /// projection). Four clip-space corners, counter-clockwise in NDC (y
+    /// up); `None` where the sphere is not wholly in front of the eye or a
+    /// corner is not finite.
+    ///
+    /// [`Attributes::detail_fill`]: crate::Attributes::detail_fill
+    pub fn screen_box(&self, sphere: &BoundingSphere) -> Option<[Vec4; 4]> {
+        let c = [sphere.center.x, sphere.center.y, sphere.center.z];
+        let r = sphere.radius;
+        if !(r >= 0.0) || !c.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let [ax, ay] = self.view.reach(c, r)?.axis;
+        let p = self.mvp.transform_point(sphere.center);
+        if !(p.is_finite() && p.w > 0.0) {
+            return None;
+        }
+        // Half extents in pixels, to clip units at the centre's `w`.
+        let [hw, hh] = self.view.half;
+        let (dx, dy) = (r * ax / hw * p.w, r * ay / hh * p.w);
+        let corner = |sx: f32, sy: f32| Vec4::new(p.x + sx * dx, p.y + sy * dy, p.z, p.w);
+        let quad = [
+            corner(-1.0, -1.0),
+            corner(1.0, -1.0),
+            corner(1.0, 1.0),
+            corner(-1.0, 1.0),
+        ];
+        quad.iter().all(|v| v.is_finite()).then_some(quad)
+    }
 }
 
 /// What a traversal decided for a run of clusters.
@@ -1068,8 +1105,9 @@ pub enum Visit {
     /// Skip clusters `a..b` (back-facing), at a leaf (`false`) or an inner
     /// node (`true`).
     Cull(usize, usize, bool),
-    /// Drop clusters `a..b`: too small on screen ([`Detail`]).
-    Detail(usize, usize),
+    /// Drop clusters `a..b`, those of node `.2` (an index into
+    /// [`ClusterSet::nodes`]): too small on screen ([`Detail`]).
+    Detail(usize, usize, usize),
 }
 
 impl ClusterSet<'_> {
@@ -1114,7 +1152,7 @@ pub(crate) fn traverse(
             continue;
         }
         if detail.is_some_and(|d| d.drops(&node.sphere)) {
-            f(Visit::Detail(a, b));
+            f(Visit::Detail(a, b, i));
             i = skip;
             continue;
         }

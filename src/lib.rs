@@ -119,7 +119,7 @@ pub use normal_mask::{BackMask, NormalClasses};
 pub use occlusion::{HiZTile, Occluder, ScreenBound};
 pub use pipeline::{Submit, MAX_PIECES};
 pub use setup::SetupTriangle;
-pub use shade::{Attributes, FragmentShader, VertexColor};
+pub use shade::{Attributes, DetailFill, FragmentShader, VertexColor};
 pub use stats::{RenderStats, Stats};
 pub use strip_renderer::StripRenderer;
 

@@ -192,7 +192,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     ) -> Result<(), Error> {
         let n = check_mesh_len(mesh.indices.len())?;
         let mut parts = self.parts();
-        if culled_object(&mut parts, mesh, mvp, n) {
+        if culled_object::<S, N, _, _>(&mut parts, mesh, mvp, n, first_id)? {
             return Ok(());
         }
         let job = MeshJob {
@@ -216,7 +216,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
     ) -> Result<(), Error> {
         let n = check_mesh_len(mesh.indices.len())?;
         let cache = sized_cache(cache, mesh.positions.len())?;
-        if culled_object(&mut self.parts(), mesh, mvp, n) {
+        if culled_object::<S, N, _, _>(&mut self.parts(), mesh, mvp, n, first_id)? {
             return Ok(());
         }
         self.process_vertices(mvp, mesh.positions, cache);
@@ -252,7 +252,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         let n = check_mesh_len(mesh.indices.len())?;
         let cache = sized_cache(cache, mesh.positions.len())?;
         set.validate(mesh.indices.len(), mesh.positions.len())?;
-        if culled_object(&mut self.parts(), mesh, mvp, n) {
+        if culled_object::<S, N, _, _>(&mut self.parts(), mesh, mvp, n, first_id)? {
             return Ok(());
         }
         // Facing is decided by snapped areas in the clipping mode, which
@@ -337,7 +337,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         let n = check_mesh_len(mesh.indices.len())?;
         let cache = sized_cache(cache, mesh.positions.len())?;
         classes.validate(mesh.indices.len())?;
-        if culled_object(&mut self.parts(), mesh, mvp, n) {
+        if culled_object::<S, N, _, _>(&mut self.parts(), mesh, mvp, n, first_id)? {
             return Ok(());
         }
         let stage = self.stage();
@@ -460,18 +460,21 @@ fn check_mesh_len(n: usize) -> Result<u64, Error> {
     }
 }
 
-/// The bounding-sphere test of a mesh: against the frustum, and for a
-/// strip renderer against its strip; counts the whole mesh (as
-/// `culled_object` or `outside_strip`) and returns `true` if it is
-/// skipped.
-fn culled_object<K: ?Sized, A>(
+/// The bounding-sphere test of a mesh: against the frustum, by detail
+/// culling, and for a strip renderer against its strip; counts the whole
+/// mesh (as `culled_object`, `culled_detail` or `outside_strip`) and
+/// returns `true` if it is skipped. A mesh dropped by detail culling whose
+/// attributes give a fill is drawn as its box ([`BoxJob`]): the only
+/// error, [`Error::StorageFull`] for the box, leaves everything as it was.
+fn culled_object<const S: u32, const N: usize, K: Sink<N> + ?Sized, A: Attributes<N>>(
     parts: &mut Parts<'_, K>,
     mesh: &Mesh<'_, A>,
     mvp: &Mat4,
     n: u64,
-) -> bool {
+    first_id: u32,
+) -> Result<bool, Error> {
     let Some(b) = mesh.bounds else {
-        return false;
+        return Ok(false);
     };
     if b.outside_frustum(mvp) {
         *parts.stats += Stats {
@@ -479,16 +482,31 @@ fn culled_object<K: ?Sized, A>(
             culled_object: n,
             ..Stats::default()
         };
-        return true;
+        return Ok(true);
     }
     if let Some(d) = Detail::for_frame(mvp, &parts.stage.config) {
         if d.drops(&b) {
+            if let Some(fill) = mesh.attributes.detail_fill(0..mesh.indices.len()) {
+                let job = BoxJob {
+                    quad: d.screen_box(&b),
+                    fill,
+                    id: first_id,
+                };
+                run_job::<S, N, _, _>(
+                    Parts {
+                        stage: parts.stage,
+                        stats: &mut *parts.stats,
+                        sink: &mut *parts.sink,
+                    },
+                    &job,
+                )?;
+            }
             *parts.stats += Stats {
                 submitted: n,
                 culled_detail: n,
                 ..Stats::default()
             };
-            return true;
+            return Ok(true);
         }
     }
     // A strip renderer skips an object wholly above or below its strip.
@@ -499,10 +517,79 @@ fn culled_object<K: ?Sized, A>(
                 outside_strip: n,
                 ..Stats::default()
             };
-            return true;
+            return Ok(true);
         }
     }
-    false
+    Ok(false)
+}
+
+/// The two triangles of a detail box ([`Detail::screen_box`]) with
+/// constant varyings `fill`, wound to pass the frame's face culling.
+fn box_triangles<const N: usize>(
+    quad: [Vec4; 4],
+    fill: [f32; N],
+    stage: &Stage,
+) -> [[ClipVertex<N>; 3]; 2] {
+    let c = &stage.config;
+    // `quad` is counter-clockwise in NDC: kept as it is where that is the
+    // face drawn.
+    let ccw = (c.front_face == crate::FrontFace::Ccw) != (c.cull == crate::CullMode::Front);
+    let v = |k: usize| ClipVertex {
+        pos: quad[k],
+        varyings: fill,
+    };
+    if ccw {
+        [[v(0), v(1), v(2)], [v(0), v(2), v(3)]]
+    } else {
+        [[v(0), v(2), v(1)], [v(0), v(3), v(2)]]
+    }
+}
+
+/// Draws the box of one object or cluster node dropped by detail culling
+/// (counted in `Stats::detail_boxes`, not as triangles submitted or
+/// stored). No box (`quad` `None`) or a fill that is not finite draws
+/// nothing.
+fn draw_box<const S: u32, const N: usize, K: Sink<N> + ?Sized>(
+    stage: &Stage,
+    quad: Option<[Vec4; 4]>,
+    fill: [f32; N],
+    id: u32,
+    stats: &mut Stats,
+    sink: &mut K,
+) {
+    let Some(quad) = quad else {
+        return;
+    };
+    let mut boxed = Stats::default();
+    for tri in &box_triangles(quad, fill, stage) {
+        process::<S, N, K>(stage, tri, id, &mut boxed, sink);
+    }
+    stats.detail_boxes += boxed.stored;
+}
+
+/// The box of an object dropped by detail culling, as a submission of its
+/// own (so a frame's storage is checked for it first).
+struct BoxJob<const N: usize> {
+    quad: Option<[Vec4; 4]>,
+    fill: [f32; N],
+    id: u32,
+}
+
+impl<const N: usize> Job<N> for BoxJob<N> {
+    fn max_pieces(&self) -> usize {
+        2 * MAX_PIECES
+    }
+    fn bound(&self, _: &Stage) -> usize {
+        2 * MAX_PIECES
+    }
+    fn run<const S: u32, K: Sink<N> + ?Sized>(
+        &self,
+        stage: &Stage,
+        stats: &mut Stats,
+        sink: &mut K,
+    ) {
+        draw_box::<S, N, K>(stage, self.quad, self.fill, self.id, stats, sink);
+    }
 }
 
 /// One submission, run once to count (if it might not fit) and once to
@@ -813,7 +900,16 @@ struct ClusterJob<'m, A> {
 enum Skipped {
     Leaf,
     Inner,
-    Detail,
+    /// By detail culling, at this node.
+    Detail(usize),
+}
+
+/// One step of [`ClusterJob::visit_in_order`].
+enum Step {
+    /// Draw these triangles, which use these cache entries.
+    Draw(core::ops::Range<usize>, core::ops::Range<usize>),
+    /// Skip this many triangles, for this reason.
+    Skip(u64, Skipped),
 }
 
 impl<A> ClusterJob<'_, A> {
@@ -824,6 +920,15 @@ impl<A> ClusterJob<'_, A> {
         mut f: impl FnMut(core::ops::Range<usize>, core::ops::Range<usize>),
         mut g: impl FnMut(u64, Skipped),
     ) {
+        self.visit_in_order(|step| match step {
+            Step::Draw(tris, verts) => f(tris, verts),
+            Step::Skip(n, why) => g(n, why),
+        })
+    }
+
+    /// [`ClusterJob::visit`] with one callback, for callers whose two
+    /// would borrow the same state.
+    fn visit_in_order(&self, mut h: impl FnMut(Step)) {
         let clusters = self.set.clusters;
         let count = |a: usize, b: usize| -> u64 {
             clusters
@@ -845,33 +950,72 @@ impl<A> ClusterJob<'_, A> {
                     } else {
                         0..self.inner.cache.len()
                     };
-                    f(t0..t1, verts);
+                    h(Step::Draw(t0..t1, verts));
                 }
             }
-            Visit::Cull(a, b, inner) => {
-                g(
-                    count(a, b),
-                    if inner { Skipped::Inner } else { Skipped::Leaf },
-                );
-            }
-            Visit::Detail(a, b) => g(count(a, b), Skipped::Detail),
+            Visit::Cull(a, b, inner) => h(Step::Skip(
+                count(a, b),
+                if inner { Skipped::Inner } else { Skipped::Leaf },
+            )),
+            Visit::Detail(a, b, node) => h(Step::Skip(count(a, b), Skipped::Detail(node))),
         });
     }
 }
 
+impl<A> ClusterJob<'_, A> {
+    /// The box drawn in place of node `node` dropped by detail culling,
+    /// with its varyings and id (that of its first triangle); `None`
+    /// where the attributes give no fill.
+    fn detail_box<const N: usize>(&self, node: usize) -> Option<(Option<[Vec4; 4]>, [f32; N], u32)>
+    where
+        A: Attributes<N>,
+    {
+        let node = self.set.nodes.get(node)?;
+        let [a, b] = node.clusters.map(|k| k as usize);
+        let clusters = self.set.clusters.get(a..b).unwrap_or(&[]);
+        let first = clusters.first().map_or(0, |k| k.triangles[0]);
+        let end = clusters.last().map_or(first, |k| k.triangles[1]);
+        let fill = (self.inner.mesh.attributes).detail_fill(first as usize..end as usize)?;
+        let quad = self.detail.as_ref()?.screen_box(&node.sphere);
+        Some((quad, fill, self.inner.first_id.wrapping_add(first)))
+    }
+}
+
 impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
+    /// The mesh's pieces, and two box triangles a node where detail
+    /// culling may draw boxes.
     fn max_pieces(&self) -> usize {
-        self.inner.max_pieces()
+        let boxes = if self.detail.is_some() {
+            self.set.nodes.len().saturating_mul(2 * MAX_PIECES)
+        } else {
+            0
+        };
+        self.inner.max_pieces().saturating_add(boxes)
     }
 
     /// The mesh's triangle count where no cache entry needs clipping (one
     /// sequential pass), else one piece or seven per triangle of the
-    /// clusters drawn.
+    /// clusters drawn; and two box triangles per node dropped by detail
+    /// culling where it draws boxes.
     fn bound(&self, _: &Stage) -> usize {
+        let mut boxes = 0usize;
+        if self.detail.is_some() {
+            self.visit(
+                |_, _| {},
+                |_, why| {
+                    if let Skipped::Detail(node) = why {
+                        if self.detail_box::<N>(node).is_some() {
+                            boxes = boxes.saturating_add(2 * MAX_PIECES);
+                        }
+                    }
+                },
+            );
+        }
         // Where nothing needs clipping, no walk of the tree (its tests are
         // the costly part).
         self.inner
             .bound_over(|f| self.visit(|tris, _| f(tris), |_, _| {}))
+            .saturating_add(boxes)
     }
 
     fn run<const S: u32, K: Sink<N> + ?Sized>(
@@ -881,20 +1025,25 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
         sink: &mut K,
     ) {
         let mut skipped = Stats::default();
-        self.visit(
-            |tris, verts| {
-                self.inner
-                    .run_range::<S, N, K>(stage, stats, sink, tris, verts)
-            },
-            |tris, why| {
+        // A box is drawn where its node falls in the cluster order.
+        self.visit_in_order(|step| match step {
+            Step::Draw(tris, verts) => self
+                .inner
+                .run_range::<S, N, K>(stage, stats, sink, tris, verts),
+            Step::Skip(tris, why) => {
                 skipped.submitted += tris;
                 match why {
                     Skipped::Leaf => skipped.culled_cluster += tris,
                     Skipped::Inner => skipped.culled_hierarchy += tris,
-                    Skipped::Detail => skipped.culled_detail += tris,
+                    Skipped::Detail(node) => {
+                        skipped.culled_detail += tris;
+                        if let Some((quad, fill, id)) = self.detail_box::<N>(node) {
+                            draw_box::<S, N, K>(stage, quad, fill, id, stats, sink);
+                        }
+                    }
                 }
-            },
-        );
+            }
+        });
         *stats += skipped;
     }
 }

@@ -62,6 +62,54 @@ pub trait Attributes<const N: usize> {
     /// only for triangles that survive culling. Never panics (zeros where
     /// out of range).
     fn get(&self, tri: usize, vertex: u32) -> [f32; N];
+
+    /// The varyings of the box that detail culling draws in place of a
+    /// dropped object or cluster node ([`Detail::screen_box`]), whose
+    /// triangles are `triangles` (indices into the mesh's triangles: all of
+    /// them for an object; a node's, for a per-node colour), or `None`
+    /// (the default) to drop it and draw nothing. [`DetailFill`] gives a
+    /// mesh's attributes one fill; a fill that is not finite draws
+    /// nothing.
+    ///
+    /// [`Detail::screen_box`]: crate::Detail::screen_box
+    #[inline(always)]
+    fn detail_fill(&self, triangles: core::ops::Range<usize>) -> Option<[f32; N]> {
+        let _ = triangles;
+        None
+    }
+}
+
+/// Attributes `A` with the varyings of the box detail culling draws in
+/// place of what it drops (for [`VertexColor`]: its colour, say the
+/// mesh's mean colour), [`Attributes::detail_fill`]. Everything else is
+/// `A`'s.
+#[derive(Clone, Copy, Debug)]
+pub struct DetailFill<A, const N: usize> {
+    /// The mesh's attributes.
+    pub attributes: A,
+    /// The box's varyings.
+    pub fill: [f32; N],
+}
+
+impl<const N: usize, A: Attributes<N>> Attributes<N> for DetailFill<A, N> {
+    const FINITE: bool = A::FINITE;
+
+    #[inline]
+    fn complete(&self, triangles: usize, vertices: usize) -> bool {
+        self.attributes.complete(triangles, vertices)
+    }
+    #[inline]
+    fn has(&self, tri: usize, idx: [u32; 3]) -> bool {
+        self.attributes.has(tri, idx)
+    }
+    #[inline]
+    fn get(&self, tri: usize, vertex: u32) -> [f32; N] {
+        self.attributes.get(tri, vertex)
+    }
+    #[inline]
+    fn detail_fill(&self, _: core::ops::Range<usize>) -> Option<[f32; N]> {
+        Some(self.fill)
+    }
 }
 
 impl Attributes<3> for MeshColors<'_> {

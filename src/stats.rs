@@ -63,6 +63,11 @@ pub struct Stats {
     /// portals lets the eye see it ([`portal`](crate::portal); counted by
     /// the caller that skips them).
     pub culled_portal: u64,
+    /// Set-up pieces of the boxes drawn in place of what detail culling
+    /// dropped, where the mesh's attributes give a fill
+    /// ([`DetailFill`](crate::DetailFill)); not counted in `stored`, and
+    /// not triangles submitted.
+    pub detail_boxes: u64,
 }
 
 impl Stats {
@@ -107,6 +112,7 @@ impl Stats {
             culled_mask: self.culled_mask.saturating_add(o.culled_mask),
             culled_occlusion: self.culled_occlusion.saturating_add(o.culled_occlusion),
             culled_portal: self.culled_portal.saturating_add(o.culled_portal),
+            detail_boxes: self.detail_boxes.saturating_add(o.detail_boxes),
         }
     }
 }

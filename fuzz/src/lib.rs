@@ -955,6 +955,7 @@ fn diff(a: &Stats, b: &Stats) -> Stats {
         culled_mask: b.culled_mask - a.culled_mask,
         culled_occlusion: b.culled_occlusion - a.culled_occlusion,
         culled_portal: b.culled_portal - a.culled_portal,
+        detail_boxes: b.detail_boxes - a.detail_boxes,
     }
 }
 

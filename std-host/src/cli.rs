@@ -902,9 +902,11 @@ pub struct CullArgs {
     #[arg(long)]
     pub copies: bool,
 
-    /// Also measure detail culling at PX pixels (a row "culling volumes,
-    /// tree, detail"; lossy: its pixels differing are reported; 0: no
-    /// such row).
+    /// Also measure detail culling at PX pixels (rows "culling volumes,
+    /// tree, detail", what it drops left out, and "... boxes for detail",
+    /// drawn as boxes in the mesh's colour; lossy: their pixels differing
+    /// from the mesh drawn in that one colour are reported; 0: no such
+    /// rows).
     #[arg(long, value_name = "PX", default_value_t = 0)]
     pub detail: u16,
 

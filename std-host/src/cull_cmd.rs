@@ -22,7 +22,7 @@ use crate::normal_mask::{self, NormalClassData};
 use microraster::cull::{Detail, Eye, Visit};
 use microraster::normal_mask::NO_CLASS;
 use microraster::prelude::*;
-use microraster::BackMask;
+use microraster::{BackMask, DetailFill};
 use microraster::{
     BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
     ProcessedVertex, SetupTriangle, Stats, Vec3,
@@ -49,6 +49,9 @@ pub enum Method {
     /// Culling volumes, tree top-down, with detail culling (lossy; only
     /// with `--detail`).
     Detail,
+    /// [`Method::Detail`], with what it drops drawn as boxes in the
+    /// mesh's colour (`DetailFill`; only with `--detail`).
+    DetailBoxes,
     /// Normal masks of this many partitions a side, on the clustered
     /// mesh's triangle order (`--normal-masks`).
     Mask(u8),
@@ -71,7 +74,9 @@ impl Method {
         let (test, hierarchy) = match self {
             Method::Source | Method::Clustered | Method::Mask(_) => return None,
             Method::Volumes => (ClusterTest::Volumes, false),
-            Method::VolumesTree | Method::Detail => (ClusterTest::Volumes, true),
+            Method::VolumesTree | Method::Detail | Method::DetailBoxes => {
+                (ClusterTest::Volumes, true)
+            }
             Method::Cones => (ClusterTest::Cones, false),
             Method::ConesTree => (ClusterTest::Cones, true),
         };
@@ -87,6 +92,7 @@ impl Method {
             Method::Cones => "normal cones, leaves",
             Method::ConesTree => "normal cones, tree",
             Method::Detail => "culling volumes, tree, detail",
+            Method::DetailBoxes => "culling volumes, tree, boxes for detail",
             Method::Mask(n) => return format!("normal masks, N = {n}"),
         };
         s.to_string()
@@ -257,6 +263,16 @@ struct Case<'a> {
     classes: Option<&'a NormalClassData>,
     /// The frame's settings (with detail culling for [`Method::Detail`]).
     config: Config,
+    /// The varyings of detail culling's boxes ([`Method::DetailBoxes`]).
+    fill: Option<[f32; 3]>,
+}
+
+impl Method {
+    /// Whether the method drops by detail (lossy): its frames are set
+    /// against the clustered mesh drawn in one colour, and so is it.
+    fn lossy(self) -> bool {
+        matches!(self, Method::Detail | Method::DetailBoxes)
+    }
 }
 
 /// Submits one frame; returns its stats.
@@ -267,6 +283,18 @@ fn submit(
     cache: &mut [ProcessedVertex],
 ) -> Result<Stats, String> {
     match (case.set, case.classes) {
+        (Some((c, cull)), _) if case.fill.is_some() => {
+            let mesh = Mesh {
+                positions: case.mesh.positions,
+                indices: case.mesh.indices,
+                attributes: DetailFill {
+                    attributes: case.mesh.attributes,
+                    fill: case.fill.unwrap_or_default(),
+                },
+                bounds: case.mesh.bounds,
+            };
+            frame.submit_clusters(&mesh, mvp, &c.set(), cull, 0, cache)
+        }
         (Some((c, cull)), _) => frame.submit_clusters(&case.mesh, mvp, &c.set(), cull, 0, cache),
         (None, Some(c)) => frame.submit_masked(&case.mesh, mvp, &c.set(), 0, cache),
         (None, None) => frame.submit_mesh_cached(&case.mesh, mvp, 0, cache),
@@ -349,9 +377,23 @@ fn measure(
         attributes: MeshColors::PerTriangle(&colors),
         bounds: None,
     };
+    // Lossy rows are set against this mesh (in one colour, so a box in
+    // that colour is right where it covers the mesh).
+    let white_colors = vec![white; clustered.indices.len()];
+    let cmesh_white = Mesh {
+        attributes: MeshColors::PerTriangle(&white_colors),
+        ..cmesh
+    };
+    let reference_white = Case {
+        mesh: cmesh_white,
+        set: None,
+        classes: None,
+        config,
+        fill: None,
+    };
     let mut methods = Method::ALL.to_vec();
     if args.detail > 0 {
-        methods.push(Method::Detail);
+        methods.extend([Method::Detail, Method::DetailBoxes]);
     }
     let class_data: Vec<NormalClassData> = args
         .normal_masks
@@ -362,7 +404,11 @@ fn measure(
     let cases: Vec<Case<'_>> = methods
         .iter()
         .map(|m| Case {
-            mesh: if *m == Method::Source { source } else { cmesh },
+            mesh: match m {
+                Method::Source => source,
+                _ if m.lossy() => cmesh_white,
+                _ => cmesh,
+            },
             set: m.cull().map(|c| (clustered, c)),
             classes: match m {
                 Method::Mask(n) => args
@@ -373,12 +419,16 @@ fn measure(
                 _ => None,
             },
             config: Config {
-                detail: if *m == Method::Detail { args.detail } else { 0 },
+                detail: if m.lossy() { args.detail } else { 0 },
                 ..config
             },
+            fill: (*m == Method::DetailBoxes).then_some([255.0; 3]),
         })
         .collect();
-    let cap = clustered.indices.len().max(indices.len()) * 2 + 64;
+    // Room for two pieces a triangle, and boxes' pieces.
+    let cap = clustered.indices.len().max(indices.len()) * 7
+        + clustered.nodes.len() * 2 * microraster::MAX_PIECES
+        + 64;
     let mut storage = vec![SetupTriangle::EMPTY; cap];
     let mut cache =
         vec![ProcessedVertex::default(); clustered.positions.len().max(positions.len())];
@@ -403,6 +453,19 @@ fn measure(
     let cams = mvps.len().max(1) as f64;
     for mvp in &mvps {
         let mut want: Option<(Vec<u8>, Vec<Rgb888>)> = None;
+        let mut want_white: Option<(Vec<u8>, Vec<Rgb888>)> = None;
+        if methods.iter().any(|m| m.lossy()) {
+            let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
+            submit(&mut frame, &reference_white, mvp, &mut cache)?;
+            color.fill(Rgb888::BLACK);
+            depth.fill(u16::MAX);
+            frame
+                .render_rows(0, h, &mut color, &mut depth[..])
+                .map_err(|e| e.to_string())?;
+            let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+            bytes.extend(depth.iter().flat_map(|d| d.to_le_bytes()));
+            want_white = Some((bytes, color.clone()));
+        }
         for (row, case) in rows.iter_mut().zip(&cases) {
             let mut frame = Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
             let s = submit(&mut frame, case, mvp, &mut cache)?;
@@ -419,8 +482,13 @@ fn measure(
             if row.method != Method::Source {
                 let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
                 bytes.extend(depth.iter().flat_map(|d| d.to_le_bytes()));
-                match &want {
-                    None => want = Some((bytes, color.clone())),
+                let want = if row.method.lossy() {
+                    &mut want_white
+                } else {
+                    &mut want
+                };
+                match want {
+                    None => *want = Some((bytes, color.clone())),
                     Some((w, c)) if *w != bytes => {
                         row.frames_differing += 1;
                         let n = c.iter().zip(&color).filter(|(a, b)| a != b).count();
@@ -577,7 +645,7 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
         for row in &r.rows {
             s += &format!(
                 "| {} | {:.0} | {:.1} % | {:.0} | {:.0} | {:.3} ({:.3}-{:.3}) | {:.3} ({:.3}-{:.3}) | {} |\n",
-                if row.method == Method::Detail {
+                if row.method.lossy() {
                     format!("{} {} px", row.method.label(), args.detail)
                 } else {
                     row.method.label()
@@ -594,7 +662,7 @@ pub fn markdown(reports: &[ModelReport], args: &CullArgs) -> String {
                 row.frame_ms[2],
                 match row.method {
                     Method::Source => "-".to_string(),
-                    Method::Detail => format!(
+                    Method::Detail | Method::DetailBoxes => format!(
                         "{} ({:.1} pixels a frame)",
                         row.frames_differing, row.pixels_differing
                     ),

@@ -102,7 +102,12 @@ fn check(m: &ClusteredMesh, mvp: &Mat4, mode: CullMode, pixels: u16, hierarchy: 
     let eye = Eye::for_frame::<8>(mvp, &config);
     let mut dropped = 0u64;
     m.set().visit(eye.as_ref(), detail.as_ref(), cull, |v| {
-        let Visit::Detail(a, b) = v else { return };
+        let Visit::Detail(a, b, node) = v else { return };
+        assert_eq!(
+            m.nodes[node].clusters,
+            [a as u32, b as u32],
+            "the node dropped"
+        );
         let clusters = &m.clusters[a..b];
         dropped += clusters
             .iter()
