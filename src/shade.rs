@@ -69,8 +69,11 @@ pub trait Attributes<const N: usize> {
     /// them for an object; a node's, for a per-node colour), or `None`
     /// (the default) to drop it and draw nothing. [`DetailFill`] gives a
     /// mesh's attributes one fill; a fill that is not finite draws
-    /// nothing.
+    /// nothing. A box covers its sphere's projection and so reaches
+    /// beyond it: under an [`Occluder`], submit an object that may become
+    /// a box unbounded (`sphere: None`).
     ///
+    /// [`Occluder`]: crate::Occluder
     /// [`Detail::screen_box`]: crate::Detail::screen_box
     #[inline(always)]
     fn detail_fill(&self, triangles: core::ops::Range<usize>) -> Option<[f32; N]> {

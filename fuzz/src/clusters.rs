@@ -13,6 +13,11 @@
 //! that `submit_mesh_cached` does not, in its order (detail culling drops
 //! whole clusters, so that holds with it too).
 //!
+//! With a detail fill (`DetailFill`, any floats): the same refusals, a
+//! failed submission counts and stores nothing, and a successful one
+//! counts what the submission without a fill counts, plus its boxes'
+//! pieces, each stored after or among the plain pieces.
+//!
 //! Normal masks on the same mesh, matrix and settings: classes built
 //! honestly (each triangle's class, per class its sizes and sphere) or
 //! arbitrary (any partitions, class ids, lengths, NaN and huge sizes and
@@ -29,7 +34,8 @@ use microraster::prelude::Submit;
 use microraster::NormalClasses;
 use microraster::{
     BoundingSphere, Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Config, CullMode,
-    Error, Frame, FrontFace, Mesh, MeshColors, ProcessedVertex, SetupTriangle, Vec3,
+    DetailFill, Error, Frame, FrontFace, Mesh, MeshColors, ProcessedVertex, SetupTriangle, Stats,
+    Vec3,
 };
 
 /// Raw node data.
@@ -63,6 +69,8 @@ pub struct ClusterInput {
     hierarchy: bool,
     /// Detail culling's threshold in pixels (0: off).
     detail: u8,
+    /// Detail culling draws boxes in these varyings (any floats).
+    fill: Option<[F; 3]>,
     storage: u8,
     /// Normal masks: partitions a side (honest: 1..=16 from it), and
     /// arbitrary classes, sizes and spheres.
@@ -318,6 +326,59 @@ pub fn run_clusters(input: &ClusterInput) {
             }
         }
         (r, v) => panic!("submit_clusters {r:?} but validate {v:?}"),
+    }
+    if let Some(fill) = input.fill {
+        let filled = Mesh {
+            positions: mesh.positions,
+            indices: mesh.indices,
+            attributes: DetailFill {
+                attributes: mesh.attributes,
+                fill: fill.map(|f| f.0),
+            },
+            bounds: None,
+        };
+        // Without a fill, with room for everything.
+        let mut st_plain = vec![SetupTriangle::EMPTY; t.len() * 7 + 1];
+        let mut plain = Frame::<8>::with_subpixel_bits(config, &mut st_plain).expect("valid size");
+        let plain_result = plain.submit_clusters(&mesh, &mvp, &set, cull, 0, &mut cache);
+        let mut st = vec![SetupTriangle::EMPTY; room];
+        let mut frame = Frame::<8>::with_subpixel_bits(config, &mut st).expect("valid size");
+        let r = frame.submit_clusters(&filled, &mvp, &set, cull, 0, &mut cache);
+        let after = frame.stats();
+        match (r, plain_result) {
+            (Err(Error::InvalidClusters(f)), Err(Error::InvalidClusters(g))) => {
+                assert_eq!(f, g);
+                assert_eq!(after, Stats::default(), "a refused set counts nothing");
+                assert!(frame.triangles().is_empty());
+            }
+            (Err(Error::StorageFull { .. }), Ok(())) => {
+                assert_eq!(
+                    after,
+                    Stats::default(),
+                    "a failed submission counts nothing"
+                );
+                assert!(frame.triangles().is_empty());
+            }
+            (Ok(()), Ok(())) => {
+                let boxes = after.detail_boxes;
+                assert_eq!(
+                    Stats {
+                        detail_boxes: 0,
+                        ..after
+                    },
+                    plain.stats(),
+                    "boxes change no triangle counter"
+                );
+                assert_eq!(
+                    frame.triangles().len() as u64,
+                    plain.triangles().len() as u64 + boxes
+                );
+                if config.detail == 0 {
+                    assert_eq!(boxes, 0);
+                }
+            }
+            (r, v) => panic!("with a fill {r:?}, without {v:?}"),
+        }
     }
     run_masks(input, &mesh, &mvp, config, &reference);
 }

@@ -262,6 +262,7 @@ pub fn sphere_scene(view: &View, stacks: u32, slices: u32) -> Result<(Scene, Spi
             normal_classes: None,
             aabb: None,
             parts: None,
+            detail_fill: None,
         }],
         clip_tris: Vec::new(),
     };
@@ -395,6 +396,7 @@ pub fn quad_scene() -> Scene {
             normal_classes: None,
             aabb: None,
             parts: None,
+            detail_fill: None,
         }],
         clip_tris: Vec::new(),
     }
@@ -707,6 +709,7 @@ impl SpotGrid {
                     normal_classes: None,
                     aabb: self.aabb,
                     parts: Some(self.parts.clone()),
+                    detail_fill: None,
                 });
             }
         }

@@ -291,6 +291,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "PX", default_value_t = 0)]
     pub cull_detail: u16,
 
+    /// With --cull-detail: draw what it drops as boxes in each object's
+    /// mean colour instead of leaving holes (lossy too).
+    #[arg(long, requires = "cull_detail")]
+    pub cull_detail_boxes: bool,
+
     /// Depth buffer format.
     #[arg(long, value_enum, default_value_t = DepthArg::U32)]
     pub depth: DepthArg,
@@ -548,6 +553,11 @@ pub struct BenchArgs {
     /// pixels across, before transform.
     #[arg(long, value_name = "PX", default_value_t = 0)]
     pub cull_detail: u16,
+
+    /// With --cull-detail: draw what it drops as boxes in each object's
+    /// mean colour instead of leaving holes (lossy too).
+    #[arg(long, requires = "cull_detail")]
+    pub cull_detail_boxes: bool,
 
     /// Depth buffer format [default: u16 for sphere, else u32].
     #[arg(long, value_enum)]

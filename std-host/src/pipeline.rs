@@ -119,7 +119,8 @@ pub fn fill<const S: u32, K: Submit<S>>(
                 let mut mesh = o.mesh();
                 mesh.indices = &o.indices[r.clone()];
                 if let ObjectColors::PerTriangle(c) = &o.colors {
-                    mesh.attributes = MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
+                    mesh.attributes.colors =
+                        MeshColors::PerTriangle(c.get(r.clone()).unwrap_or(&[]));
                 }
                 let id = first_ids[*i].wrapping_add(r.start as u32);
                 if let Some(c) = &o.clusters {
@@ -132,6 +133,11 @@ pub fn fill<const S: u32, K: Submit<S>>(
                     let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
                     frame.submit_masked(&o.mesh(), &o.mvp, &c.set(), id, &mut cache)?;
                     continue;
+                }
+                // An object split among pieces draws its detail box (if
+                // dropped whole) with its first piece only.
+                if r.start != 0 {
+                    mesh.attributes.fill = None;
                 }
                 match caches.get(*i).copied().flatten() {
                     Some(cache) => frame.submit_processed_mesh(&mesh, id, cache)?,
@@ -530,6 +536,14 @@ fn build_chunks<'s, const S: u32>(
     })
 }
 
+/// Whether detail culling (`config.detail`) drops object `o` whole, by its
+/// bounds: then no vertex of it is processed, and `submit_mesh` drops it
+/// (drawing its box where it has a fill).
+pub fn dropped_by_detail(o: &crate::scene::Object, config: &Config) -> bool {
+    let detail = microraster::Detail::for_frame(&o.mvp, config);
+    matches!((o.bounds, detail), (Some(b), Some(d)) if d.drops(&b))
+}
+
 /// Runs the vertex stage of every object of `scene` inside the frustum into
 /// `caches` (grown as needed), `threads` workers per object. Returns each
 /// object's processed vertices, `None` for one outside the frustum.
@@ -550,6 +564,7 @@ fn vertex_stage<'c, const S: u32>(
         if o.clusters.is_some()
             || o.normal_classes.is_some()
             || o.bounds.is_some_and(|b| b.outside_frustum(&o.mvp))
+            || dropped_by_detail(o, &config)
         {
             out.push(None);
             continue;

@@ -137,6 +137,7 @@ impl MeshBuilder {
             clusters: None,
             normal_classes: None,
             parts: None,
+            detail_fill: None,
         }
     }
 }
@@ -649,6 +650,7 @@ fn ball(c: Vec3, r: f32, rng: &mut Rng) -> Object {
         clusters: None,
         normal_classes: None,
         parts: None,
+        detail_fill: None,
     }
 }
 

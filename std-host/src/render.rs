@@ -158,6 +158,9 @@ pub struct Counters {
     /// Skipped with their rooms, never submitted, by portal culling
     /// (`--portals`; counted in `submitted` too).
     pub culled_portal: u64,
+    /// Pieces set up for the boxes drawn in place of what detail culling
+    /// dropped (`--cull-detail-boxes`; not in `stored`).
+    pub detail_boxes: u64,
 }
 
 impl From<&Stats> for Counters {
@@ -178,6 +181,7 @@ impl From<&Stats> for Counters {
             culled_mask: s.culled_mask,
             culled_occlusion: s.culled_occlusion,
             culled_portal: s.culled_portal,
+            detail_boxes: s.detail_boxes,
         }
     }
 }
@@ -368,7 +372,7 @@ fn render_immediate<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result
                                     vec![HiZTile::default(); tiles_for(x1 - x0, y1 - y0)];
                                 let mut o = r.occluder(&mut tiles)?;
                                 o.set_hiding(hiz);
-                                fill_occluded::<S, _, _>(&mut o, scene, &caches)?;
+                                fill_occluded::<S, _, _>(&mut o, scene, &caches, &config)?;
                             } else {
                                 fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
                             }
@@ -469,6 +473,16 @@ fn draw_object<const S: u32, C: PixelFormat, W: DepthWord>(
 ) -> Result<(), microraster::Error> {
     let scratch = || vec![ProcessedVertex::EMPTY; ob.positions.len()];
     let whole = ob.mesh();
+    // Dropped whole by detail culling: `submit_mesh` tests the bounds
+    // (and draws the box, once: with the object's first triangles).
+    if crate::pipeline::dropped_by_detail(ob, r.config()) {
+        let mut mesh = whole;
+        mesh.indices = ob.indices.get(range.clone()).unwrap_or(&[]);
+        if range.start != 0 {
+            mesh.attributes.fill = None;
+        }
+        return r.submit_mesh(&mesh, &ob.mvp, first.wrapping_add(range.start as u32));
+    }
     if let Some(c) = &ob.clusters {
         return r.submit_clusters(&whole, &ob.mvp, &c.set(), c.cull, first, &mut scratch());
     }
@@ -483,7 +497,8 @@ fn draw_object<const S: u32, C: PixelFormat, W: DepthWord>(
     let mut mesh = whole;
     mesh.indices = ob.indices.get(range.clone()).unwrap_or(&[]);
     if let crate::scene::ObjectColors::PerTriangle(c) = &ob.colors {
-        mesh.attributes = microraster::MeshColors::PerTriangle(c.get(range.clone()).unwrap_or(&[]));
+        mesh.attributes.colors =
+            microraster::MeshColors::PerTriangle(c.get(range.clone()).unwrap_or(&[]));
     }
     r.submit_processed_mesh(&mesh, first.wrapping_add(range.start as u32), cache)
 }
@@ -514,12 +529,22 @@ fn fill_occluded<const S: u32, C: PixelFormat, W: DepthWord>(
     o: &mut Occluder<'_, '_, C, W, S, 3, microraster::VertexColor>,
     scene: &Scene,
     caches: &[OnceLock<Vec<ProcessedVertex>>],
+    config: &Config,
 ) -> Result<(), microraster::Error> {
     let mut id = 0u32;
     for (ob, cache) in scene.objects.iter().zip(caches) {
         let first = id;
         let n = ob.indices.len();
         id = id.wrapping_add(n as u32);
+        // A detail box reaches beyond the object's bounds (it covers their
+        // projection), so it is drawn unbounded: no test, and the strip's
+        // hi-z read again after it.
+        if ob.detail_fill.is_some() && crate::pipeline::dropped_by_detail(ob, config) {
+            o.submit_with(None, &ob.mvp, n as u64, |r| {
+                draw_object(r, ob, 0..n, first, cache)
+            })?;
+            continue;
+        }
         let (sphere, aabb) = (ob.bounds.as_ref(), ob.aabb.as_ref());
         match &ob.parts {
             Some(parts) if ob.clusters.is_none() && ob.normal_classes.is_none() => {

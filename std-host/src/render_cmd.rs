@@ -87,6 +87,9 @@ pub fn load_scene(args: &RenderArgs) -> Result<Scene, String> {
     if let Some(n) = args.normal_masks {
         crate::normal_mask::mask_scene(&mut scene, n)?;
     }
+    if args.cull_detail_boxes {
+        crate::scene::detail_boxes(&mut scene);
+    }
     Ok(scene)
 }
 
@@ -319,8 +322,12 @@ fn nonzero(c: &Counters) -> String {
             c.culled_hierarchy,
         ),
         (
-            "cluster below --cull-detail pixels (before transform)",
+            "object or cluster below --cull-detail pixels (before transform)",
             c.culled_detail,
+        ),
+        (
+            "box pieces drawn for them (--cull-detail-boxes)",
+            c.detail_boxes,
         ),
         ("back-facing normal class (before transform)", c.culled_mask),
         (

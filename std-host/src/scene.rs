@@ -15,7 +15,7 @@
 
 use crate::cliptris::ClipTri;
 use microraster::math::radians;
-use microraster::pixelcolor::Rgb888;
+use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::{BoundingSphere, Mat4, Mesh, MeshColors, Vec3};
 
 /// One mesh to draw, with its own transform to clip space.
@@ -45,6 +45,61 @@ pub struct Object {
     /// tested after the whole object. Triangles after the last part are
     /// drawn without a test.
     pub parts: Option<std::sync::Arc<Vec<crate::occlusion::Part>>>,
+    /// Detail culling draws what it drops of this object as boxes in this
+    /// colour (`0.0..=255.0`; see [`microraster::DetailFill`]); `None`
+    /// drops it. [`detail_boxes`] sets each object's mean colour.
+    pub detail_fill: Option<[f32; 3]>,
+}
+
+/// An [`Object`]'s varyings: its colours, and the fill of detail
+/// culling's boxes.
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectAttributes<'a> {
+    /// The colours.
+    pub colors: MeshColors<'a>,
+    /// [`Object::detail_fill`].
+    pub fill: Option<[f32; 3]>,
+}
+
+impl microraster::Attributes<3> for ObjectAttributes<'_> {
+    const FINITE: bool = true;
+
+    #[inline]
+    fn complete(&self, triangles: usize, vertices: usize) -> bool {
+        self.colors.complete(triangles, vertices)
+    }
+    #[inline]
+    fn has(&self, tri: usize, idx: [u32; 3]) -> bool {
+        self.colors.has(tri, idx)
+    }
+    #[inline]
+    fn get(&self, tri: usize, vertex: u32) -> [f32; 3] {
+        self.colors.get(tri, vertex)
+    }
+    #[inline]
+    fn detail_fill(&self, _: std::ops::Range<usize>) -> Option<[f32; 3]> {
+        self.fill
+    }
+}
+
+/// Sets every object's [`Object::detail_fill`] to its mean colour (over
+/// its triangles, or its vertices for per-vertex colours), so detail
+/// culling draws boxes instead of holes.
+pub fn detail_boxes(scene: &mut Scene) {
+    for o in &mut scene.objects {
+        let cs = match &o.colors {
+            ObjectColors::PerTriangle(c) | ObjectColors::PerVertex(c) => c,
+        };
+        let n = cs.len().max(1) as f64;
+        let sum = cs.iter().fold([0.0f64; 3], |a, c| {
+            [
+                a[0] + f64::from(c.r()),
+                a[1] + f64::from(c.g()),
+                a[2] + f64::from(c.b()),
+            ]
+        });
+        o.detail_fill = Some(sum.map(|v| (v / n) as f32));
+    }
 }
 
 /// The clusters of an [`Object`] and how they are tested.
@@ -92,11 +147,14 @@ impl ObjectColors {
 
 impl Object {
     /// As the core's [`Mesh`].
-    pub fn mesh(&self) -> Mesh<'_> {
+    pub fn mesh(&self) -> Mesh<'_, ObjectAttributes<'_>> {
         Mesh {
             positions: &self.positions,
             indices: &self.indices,
-            attributes: self.colors.as_mesh_colors(),
+            attributes: ObjectAttributes {
+                colors: self.colors.as_mesh_colors(),
+                fill: self.detail_fill,
+            },
             bounds: self.bounds,
         }
     }
@@ -236,6 +294,7 @@ pub fn cubes_scene(view: &View) -> Result<Scene, String> {
             normal_classes: None,
             aabb: None,
             parts: None,
+            detail_fill: None,
         })
         .collect();
     Ok(Scene {
@@ -296,6 +355,7 @@ pub fn mesh_scene(
             normal_classes: None,
             aabb: None,
             parts: None,
+            detail_fill: None,
         }],
         clip_tris: Vec::new(),
     })

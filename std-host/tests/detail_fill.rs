@@ -363,3 +363,74 @@ fn a_far_object_dropped_whole_is_drawn_as_its_box() {
     assert_eq!(frame.stats().detail_boxes, 0);
     assert!(frame.triangles().is_empty());
 }
+
+/// `render` (and so `render --cull-detail`, `bench --cull-detail`) drops
+/// far objects whole, by their bounds, on every path: binned, on threads,
+/// strip by strip with occlusion culling. With `scene::detail_boxes` they
+/// become boxes in their mean colour, and the frame (colour, depth, ids)
+/// is the same on 1 to 3 threads, at any strip height, with or without
+/// occlusion culling.
+#[test]
+fn render_drops_far_objects_and_draws_their_boxes_on_every_path() {
+    use microraster_host::bench_scenes::SpotGrid;
+    use microraster_host::render::{render, DepthKind, Occlusion, RenderOptions};
+    let (w, h) = (160u32, 120u32);
+    let spots = SpotGrid::load().unwrap();
+    let mut scene = spots
+        .scene(
+            6,
+            [0.0, 8.0, 25.0],
+            [0.0; 3],
+            60.0,
+            w as f32 / h as f32,
+            false,
+        )
+        .unwrap();
+    let opts = |detail, threads, rows, occlusion| RenderOptions {
+        width: w,
+        height: h,
+        cull: CullMode::Back,
+        detail,
+        depth: DepthKind::U16,
+        subpixel: 8,
+        threads,
+        strip_rows: rows,
+        tile_width: 0,
+        ids: true,
+        mode: microraster::RasterMode::Clipping,
+        inv_w: false,
+        occlusion,
+    };
+    let exact = render(&scene, &opts(0, 1, h, Occlusion::Off)).unwrap();
+    let holes = render(&scene, &opts(12, 1, h, Occlusion::Off)).unwrap();
+    let n = scene.triangle_count() as u64;
+    assert_eq!(exact.stats.culled_detail, 0);
+    assert!(
+        holes.stats.culled_detail * 2 > n,
+        "{} of {n} dropped",
+        holes.stats.culled_detail
+    );
+    assert_eq!(holes.stats.detail_boxes, 0);
+    assert!(holes.rgb != exact.rgb);
+    microraster_host::scene::detail_boxes(&mut scene);
+    assert!(scene.objects.iter().all(|o| o.detail_fill.is_some()));
+    let boxed = render(&scene, &opts(12, 1, h, Occlusion::Off)).unwrap();
+    assert_eq!(boxed.stats.culled_detail, holes.stats.culled_detail);
+    assert!(boxed.stats.detail_boxes > 0);
+    assert!(boxed.rgb != holes.rgb);
+    // Off, the fills change nothing.
+    let off = render(&scene, &opts(0, 1, h, Occlusion::Off)).unwrap();
+    assert!(off.rgb == exact.rgb && off.depth == exact.depth);
+    for (threads, rows, occlusion) in [
+        (2, h, Occlusion::Off),
+        (3, 7, Occlusion::Off),
+        (1, 16, Occlusion::Strips),
+        (2, 5, Occlusion::On),
+    ] {
+        let r = render(&scene, &opts(12, threads, rows, occlusion)).unwrap();
+        let at = format!("{threads} threads, {rows} rows, {occlusion:?}");
+        assert!(r.rgb == boxed.rgb, "colour, {at}");
+        assert!(r.depth == boxed.depth, "depth, {at}");
+        assert!(r.ids == boxed.ids, "ids, {at}");
+    }
+}

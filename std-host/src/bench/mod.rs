@@ -201,6 +201,9 @@ pub fn load(args: &BenchArgs, s: &Settings) -> Result<BenchScene, String> {
     if let Some(n) = args.normal_masks {
         crate::normal_mask::mask_scene(&mut bs.scene, n)?;
     }
+    if args.cull_detail_boxes {
+        crate::scene::detail_boxes(&mut bs.scene);
+    }
     if bs.spin.is_some() || s.spin != 0.0 {
         let mut spin = bs
             .spin
