@@ -902,3 +902,41 @@ fn portals_draw_the_same_house_and_count_the_rooms() {
     assert!(e.contains("--id-out"), "{e}");
     assert!(!out.exists() && !ids.exists());
 }
+
+/// `render --cull-detail N` drops far objects whole (the herd from
+/// afar), and `--cull-detail-boxes` draws them as boxes: the same
+/// triangles dropped, box pieces counted, another image; the boxes
+/// without `--cull-detail` are refused.
+#[test]
+fn cull_detail_drops_far_objects_and_boxes_draw_them() {
+    let far = [
+        "--scene",
+        "spots",
+        "--eye",
+        "0,12,40",
+        "--target",
+        "0,0,0",
+        "--size",
+        "160x120",
+    ];
+    let c = |v: &Value, k: &str| v["counters"][k].as_u64().unwrap();
+    let (exact, _) = stats(&far);
+    let mut holes_args = far.to_vec();
+    holes_args.extend(["--cull-detail", "7"]);
+    let (holes, _) = stats(&holes_args);
+    let mut boxes_args = holes_args.clone();
+    boxes_args.push("--cull-detail-boxes");
+    let (boxes, _) = stats(&boxes_args);
+    assert_eq!(c(&exact, "culled_detail"), 0);
+    assert!(c(&holes, "culled_detail") > 0, "{holes}");
+    assert_eq!(c(&holes, "detail_boxes"), 0);
+    assert_eq!(c(&boxes, "culled_detail"), c(&holes, "culled_detail"));
+    assert!(c(&boxes, "detail_boxes") > 0, "{boxes}");
+    assert_ne!(exact["checksum"], holes["checksum"]);
+    assert_ne!(holes["checksum"], boxes["checksum"]);
+    let out = tmp("boxes-alone.png");
+    let o = run(&["render", "--cull-detail-boxes", "--out", out.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--cull-detail"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
