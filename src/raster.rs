@@ -880,9 +880,11 @@ fn draw_in<
     }
 
     // Flat span triangles, where `EARLY_FLAT` is off (otherwise they
-    // returned above); then the smooth spans.
+    // returned above), with the edges and depth plane set up here; then
+    // the smooth spans.
     if !EARLY_FLAT && !shader.smooth {
-        return flat_rows::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat);
+        let rows = (row_first, row_last);
+        return flat_rows_given::<N, C, D, R, T>(t, rows, strip, flat, edges, &shader);
     }
     {
         let mut spans = RowSpans::new(&edges, max_n);
@@ -1119,8 +1121,37 @@ fn flat_rows<
     strip: &mut Strip<'_, C, D>,
     px: C,
 ) -> u32 {
-    let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
+    let edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
     let shader = &Shader::<R, N>::new::<C, D, T>(t, &edges);
+    flat_rows_from::<N, C, D, R, T>(t, (row_first, row_last), strip, px, edges, shader)
+}
+
+/// [`flat_rows`] for a triangle whose edges and depth plane its caller has
+/// set up already (64-bit hosts, where `EARLY_FLAT` is off): out of line,
+/// as `flat_rows` is.
+#[inline(never)]
+fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
+    t: &SetupTriangle<N>,
+    rows: (u32, u32),
+    strip: &mut Strip<'_, C, D>,
+    px: C,
+    edges: [Edge<T>; 3],
+    shader: &Shader<R, N>,
+) -> u32 {
+    flat_rows_from::<N, C, D, R, T>(t, rows, strip, px, edges, shader)
+}
+
+/// The rows of [`flat_rows`], from the edges at the first row and the
+/// depth plane.
+#[inline(always)]
+fn flat_rows_from<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: Real, T: EdgeInt>(
+    t: &SetupTriangle<N>,
+    (row_first, row_last): (u32, u32),
+    strip: &mut Strip<'_, C, D>,
+    px: C,
+    mut edges: [Edge<T>; 3],
+    shader: &Shader<R, N>,
+) -> u32 {
     let rows = row_last - row_first + 1;
     let max_n = (t.max_x - t.min_x) as usize;
     let z = t.z;

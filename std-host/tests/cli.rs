@@ -910,14 +910,7 @@ fn portals_draw_the_same_house_and_count_the_rooms() {
 #[test]
 fn cull_detail_drops_far_objects_and_boxes_draw_them() {
     let far = [
-        "--scene",
-        "spots",
-        "--eye",
-        "0,12,40",
-        "--target",
-        "0,0,0",
-        "--size",
-        "160x120",
+        "--scene", "spots", "--eye", "0,12,40", "--target", "0,0,0", "--size", "160x120",
     ];
     let c = |v: &Value, k: &str| v["counters"][k].as_u64().unwrap();
     let (exact, _) = stats(&far);
@@ -935,7 +928,12 @@ fn cull_detail_drops_far_objects_and_boxes_draw_them() {
     assert_ne!(exact["checksum"], holes["checksum"]);
     assert_ne!(holes["checksum"], boxes["checksum"]);
     let out = tmp("boxes-alone.png");
-    let o = run(&["render", "--cull-detail-boxes", "--out", out.to_str().unwrap()]);
+    let o = run(&[
+        "render",
+        "--cull-detail-boxes",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--cull-detail"), "{}", stderr(&o));
     assert!(!out.exists());
