@@ -1349,4 +1349,61 @@ mod tests {
             assert!(!d.drops(&b), "{b:?}");
         }
     }
+
+    /// The box drawn for a dropped sphere: about the centre's projection,
+    /// at its depth, as wide as the extent along each axis, wound
+    /// counter-clockwise; none for the spheres never dropped (no bounds,
+    /// reaching behind the eye, NaN, a negative or infinite radius).
+    #[test]
+    fn detail_box_covers_the_extent_about_the_centre() {
+        let mut config = crate::Config::new(240, 120);
+        config.detail = 3;
+        let mvp = camera();
+        let d = Detail::for_frame(&mvp, &config).unwrap();
+        let ball = |x: f32, y: f32, radius: f32| BoundingSphere {
+            center: Vec3::new(x, y, 0.0),
+            radius,
+        };
+        for b in [ball(0.0, 0.0, 0.01), ball(1.0, -0.5, 0.02)] {
+            let q = d.screen_box(&b).unwrap();
+            let p = mvp.transform_point(b.center);
+            // Pixels: x = (1 + x/w) * 120, y = (1 - y/w) * 60.
+            let px = q.map(|v| [(1.0 + v.x / v.w) * 120.0, (1.0 - v.y / v.w) * 60.0]);
+            let (cx, cy) = ((1.0 + p.x / p.w) * 120.0, (1.0 - p.y / p.w) * 60.0);
+            let (w, h) = (px[1][0] - px[0][0], px[0][1] - px[3][1]);
+            let [ax, ay] = d
+                .view
+                .reach([b.center.x, b.center.y, 0.0], b.radius)
+                .unwrap()
+                .axis;
+            assert!((w - 2.0 * b.radius * ax).abs() < 1e-3, "{w}");
+            assert!((h - 2.0 * b.radius * ay).abs() < 1e-3, "{h}");
+            assert!(d.extent(&b).unwrap() >= w.max(h) * 0.9999);
+            assert!(((px[0][0] + px[1][0]) / 2.0 - cx).abs() < 1e-3);
+            assert!(((px[0][1] + px[3][1]) / 2.0 - cy).abs() < 1e-3);
+            assert!(
+                q.iter().all(|v| v.z == p.z && v.w == p.w),
+                "at the centre's depth"
+            );
+            // Counter-clockwise in NDC (y up): a positive area.
+            let ndc = q.map(|v| [v.x / v.w, v.y / v.w]);
+            let area = (ndc[1][0] - ndc[0][0]) * (ndc[2][1] - ndc[0][1])
+                - (ndc[2][0] - ndc[0][0]) * (ndc[1][1] - ndc[0][1]);
+            assert!(area > 0.0, "{area}");
+        }
+        for b in [
+            BoundingSphere::EVERYWHERE,
+            BoundingSphere {
+                center: Vec3::new(0.0, 0.0, 5.0),
+                radius: 0.01,
+            },
+            ball(f32::NAN, 0.0, 0.01),
+            ball(0.0, 0.0, -1.0),
+            ball(0.0, 0.0, f32::NAN),
+            ball(0.0, 0.0, f32::INFINITY),
+            ball(f32::MAX, 0.0, 0.01),
+        ] {
+            assert!(d.screen_box(&b).is_none(), "{b:?}");
+        }
+    }
 }
