@@ -64,7 +64,7 @@ fn cases() -> Vec<Case> {
     out
 }
 
-fn storage_for(mesh: &Mesh<'_>) -> Vec<SetupTriangle> {
+fn storage_for<A>(mesh: &Mesh<'_, A>) -> Vec<SetupTriangle> {
     let n = mesh.indices.len();
     vec![SetupTriangle::EMPTY; Frame::<8>::storage_for(n)]
 }
