@@ -486,7 +486,11 @@ fn culled_object<const S: u32, const N: usize, K: Sink<N> + ?Sized, A: Attribute
     }
     if let Some(d) = Detail::for_frame(mvp, &parts.stage.config) {
         if d.drops(&b) {
-            if let Some(fill) = mesh.attributes.detail_fill(0..mesh.indices.len()) {
+            let fill = match A::DETAIL_FILL {
+                true => mesh.attributes.detail_fill(0..mesh.indices.len()),
+                false => None,
+            };
+            if let Some(fill) = fill {
                 let job = BoxJob {
                     quad: d.screen_box(&b),
                     fill,
@@ -970,6 +974,9 @@ impl<A> ClusterJob<'_, A> {
     where
         A: Attributes<N>,
     {
+        if !A::DETAIL_FILL {
+            return None;
+        }
         let node = self.set.nodes.get(node)?;
         let [a, b] = node.clusters.map(|k| k as usize);
         let clusters = self.set.clusters.get(a..b).unwrap_or(&[]);
@@ -985,7 +992,7 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
     /// The mesh's pieces, and two box triangles a node where detail
     /// culling may draw boxes.
     fn max_pieces(&self) -> usize {
-        let boxes = if self.detail.is_some() {
+        let boxes = if self.detail.is_some() && A::DETAIL_FILL {
             self.set.nodes.len().saturating_mul(2 * MAX_PIECES)
         } else {
             0
@@ -999,7 +1006,7 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
     /// culling where it draws boxes.
     fn bound(&self, _: &Stage) -> usize {
         let mut boxes = 0usize;
-        if self.detail.is_some() {
+        if self.detail.is_some() && A::DETAIL_FILL {
             self.visit(
                 |_, _| {},
                 |_, why| {

@@ -50,6 +50,12 @@ pub trait Attributes<const N: usize> {
     /// counted in `Stats::rejected_nonfinite` by every submission path.
     const FINITE: bool = false;
 
+    /// Whether [`Attributes::detail_fill`] may give a fill (`false`, the
+    /// default: detail culling drops, and what a submission may store is
+    /// bounded without boxes). Implementors that override `detail_fill`
+    /// set it; where it is `false` the fill is never asked for.
+    const DETAIL_FILL: bool = false;
+
     /// Whether every triangle of a mesh with `triangles` triangles and
     /// `vertices` vertices has its varyings, so [`Attributes::has`] need
     /// not be asked per triangle.
@@ -67,7 +73,8 @@ pub trait Attributes<const N: usize> {
     /// dropped object or cluster node ([`Detail::screen_box`]), whose
     /// triangles are `triangles` (indices into the mesh's triangles: all of
     /// them for an object; a node's, for a per-node colour), or `None`
-    /// (the default) to drop it and draw nothing. [`DetailFill`] gives a
+    /// (the default) to drop it and draw nothing; asked only where
+    /// [`Attributes::DETAIL_FILL`] is set. [`DetailFill`] gives a
     /// mesh's attributes one fill; a fill that is not finite draws
     /// nothing. A box covers its sphere's projection and so reaches
     /// beyond it: under an [`Occluder`], submit an object that may become
@@ -96,6 +103,7 @@ pub struct DetailFill<A, const N: usize> {
 
 impl<const N: usize, A: Attributes<N>> Attributes<N> for DetailFill<A, N> {
     const FINITE: bool = A::FINITE;
+    const DETAIL_FILL: bool = true;
 
     #[inline]
     fn complete(&self, triangles: usize, vertices: usize) -> bool {

@@ -126,7 +126,25 @@ pub fn fill<const S: u32, K: Submit<S>>(
                 if let Some(c) = &o.clusters {
                     // Its own scratch cache: the vertex stage skipped it.
                     let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
-                    frame.submit_clusters(&o.mesh(), &o.mvp, &c.set(), c.cull, id, &mut cache)?;
+                    // Without a fill, plain colours: no box is bounded.
+                    match o.detail_fill {
+                        Some(_) => frame.submit_clusters(
+                            &o.mesh(),
+                            &o.mvp,
+                            &c.set(),
+                            c.cull,
+                            id,
+                            &mut cache,
+                        ),
+                        None => frame.submit_clusters(
+                            &o.plain_mesh(),
+                            &o.mvp,
+                            &c.set(),
+                            c.cull,
+                            id,
+                            &mut cache,
+                        ),
+                    }?;
                     continue;
                 }
                 if let Some(c) = &o.normal_classes {

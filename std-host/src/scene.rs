@@ -63,6 +63,7 @@ pub struct ObjectAttributes<'a> {
 
 impl microraster::Attributes<3> for ObjectAttributes<'_> {
     const FINITE: bool = true;
+    const DETAIL_FILL: bool = true;
 
     #[inline]
     fn complete(&self, triangles: usize, vertices: usize) -> bool {
@@ -146,7 +147,19 @@ impl ObjectColors {
 }
 
 impl Object {
-    /// As the core's [`Mesh`].
+    /// As the core's [`Mesh`] with plain colours, no detail fill: a
+    /// submission of it never bounds boxes (see
+    /// [`microraster::Attributes::DETAIL_FILL`]).
+    pub fn plain_mesh(&self) -> Mesh<'_> {
+        Mesh {
+            positions: &self.positions,
+            indices: &self.indices,
+            attributes: self.colors.as_mesh_colors(),
+            bounds: self.bounds,
+        }
+    }
+
+    /// As the core's [`Mesh`], with [`Object::detail_fill`].
     pub fn mesh(&self) -> Mesh<'_, ObjectAttributes<'_>> {
         Mesh {
             positions: &self.positions,
