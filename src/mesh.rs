@@ -105,13 +105,33 @@ const GAMMA: f32 = 16.0 / 16_777_216.0;
 /// `c`, radius `r`): `a(c) - err > r |n|`, compared squared (no square
 /// root in `no_std`) with a relative margin of `2^-18` for the rounding of
 /// both sides. `false` on any NaN (an overflow).
+///
+/// The relative margins hold only while the squares stay in `f32`'s
+/// normal range: a square below it (a plane with coefficients near
+/// `1e-20`, say) is rounded to a multiple of `2^-149` and can lose every
+/// digit, and an absolute error of `2^-150` per product in the vertex
+/// stage is no longer small against the plane's value. So a verdict of
+/// "beyond" stands only where `t^2` and `|n|^2` are at least
+/// [`NORMAL_SQ`]; otherwise nothing is culled. (`r^2` is not checked: a
+/// radius below `1e-15` errs in its square by at most `2^-150`, which
+/// matters only for a sphere that grazes the plane with `|n|` beyond
+/// `1e9`; left as is, since the checks cost the Cortex-M4F per test.) (The fuzz
+/// target `occlusion` found a frame whose matrix rows were near
+/// `5e-22`: the squares underflowed and a visible object was culled.)
 #[inline]
 fn beyond(a: [f32; 4], c: [f32; 4], r: f32, err: f32) -> bool {
     let at_c: f32 = (0..4).map(|j| a[j] * c[j]).sum();
     let n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     let t = at_c - err;
-    t > 0.0 && t * t > r * r * n2 * (1.0 + 1.0 / 262_144.0)
+    let t2 = t * t;
+    t > 0.0 && t2 > r * r * n2 * (1.0 + 1.0 / 262_144.0) && t2 >= NORMAL_SQ && n2 >= NORMAL_SQ
 }
+
+/// The least square [`beyond`] trusts: `1e-30`, about `2^-100`, far
+/// above `f32`'s smallest normal number (`2^-126`), so these squares carry
+/// their full relative precision, and an absolute error of `2^-150` per
+/// product is below `2^-50` of the plane value `t >= 1e-15`.
+const NORMAL_SQ: f32 = 1.0e-30;
 
 impl BoundingSphere {
     /// The centre (homogeneous), the radius and the bound `|p_j| <= |c_j| +

@@ -60,3 +60,67 @@ fn depth_does_not_depend_on_the_pixel_type() {
     assert_eq!(shaded, flat);
     assert_eq!(shaded, ids);
 }
+
+/// Found by the `occlusion` fuzz target (2026-12-05): a matrix whose rows
+/// are near `5e-22` (and one entry `3.5e9`). `BoundingSphere::outside_frustum`
+/// compares squares, and those of plane coefficients near `5e-22` fall
+/// below `f32`'s normal range and lose their digits: the test culled an
+/// object whose triangles the per-triangle path clips and draws. (Fixed:
+/// a verdict needs the squares in the normal range; otherwise nothing is
+/// culled.)
+#[test]
+fn tiny_matrix_rows_do_not_cull_a_visible_object() {
+    use microraster::{BoundingSphere, Mat4, Mesh, MeshColors, ProcessedVertex, Vec3};
+    let raw: [f32; 16] = [
+        7.255004e-39,
+        3478061000.0,
+        5.54211e-22,
+        5.806808e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+        5.54211e-22,
+    ];
+    let mut cols = [[0.0f32; 4]; 4];
+    for (i, v) in raw.iter().enumerate() {
+        cols[i / 4][i % 4] = *v;
+    }
+    let mvp = Mat4 { cols };
+    let p: Vec<Vec3> = [
+        [-62, -65, -1],
+        [1, 17, -1],
+        [1, 12, 53],
+        [12, 48, -68],
+        [-1, -1, -68],
+    ]
+    .iter()
+    .map(|c: &[i32; 3]| Vec3::new(c[0] as f32 / 16.0, c[1] as f32 / 16.0, c[2] as f32 / 16.0))
+    .collect();
+    let t = [[0u32, 1, 3], [0, 4, 2], [0, 2, 3]];
+    let mut config = Config::new(48, 195);
+    config.cull = CullMode::None;
+    let colors = [Rgb888::new(9, 9, 9); 3];
+    let mut storage = [SetupTriangle::EMPTY; 32];
+    let mut frame: Frame = Frame::new(config, &mut storage).unwrap();
+    let mesh = Mesh {
+        positions: &p,
+        indices: &t,
+        attributes: MeshColors::PerTriangle(&colors),
+        bounds: None,
+    };
+    let mut cache = vec![ProcessedVertex::EMPTY; p.len()];
+    frame
+        .submit_mesh_cached(&mesh, &mvp, 0, &mut cache)
+        .unwrap();
+    assert!(frame.stats().stored > 0, "{:?}", frame.stats());
+    let sphere = BoundingSphere::from_points(&p).unwrap();
+    assert!(!sphere.outside_frustum(&mvp), "a drawn object culled");
+}
