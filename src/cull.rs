@@ -212,7 +212,7 @@ impl NormalCone {
         }
         // d >= (cutoff + MARGIN) |g|, with d shrunk by the rounding of e.
         let d = d - ROUNDING * p1;
-        let c = self.cutoff.max(0.0) + MARGIN;
+        let c = crate::math::fx::max(self.cutoff, 0.0) + MARGIN;
         if !(d > 0.0 && d * d >= c * c * gg) {
             return None;
         }
@@ -221,10 +221,10 @@ impl NormalCone {
         // acos(beta)) = |g| (cos(theta) beta - cutoff sqrt(1 - beta^2)),
         // positive since beta >= cutoff + MARGIN.
         let len = crate::math::fx::sqrt(gg);
-        let beta = (d / len).min(1.0);
-        let cut = self.cutoff.max(0.0);
-        let cos_t = crate::math::fx::sqrt((1.0 - cut * cut).max(0.0));
-        let lb = cos_t * beta - cut * crate::math::fx::sqrt((1.0 - beta * beta).max(0.0));
+        let root = |x: f32| crate::math::fx::sqrt(crate::math::fx::max(x, 0.0));
+        let beta = crate::math::fx::min(d / len, 1.0);
+        let cut = crate::math::fx::max(self.cutoff, 0.0);
+        let lb = root(1.0 - cut * cut) * beta - cut * root(1.0 - beta * beta);
         // Shrunk for the float functions (micromath's sqrt is approximate).
         let lb = lb - 0.05 * MARGIN;
         (lb > 0.0).then_some(e.k * lb * len * (1.0 - 1.0 / 64.0))
@@ -1053,7 +1053,7 @@ impl Detail {
             return None;
         }
         let [ax, ay] = self.view.reach(c, r)?.axis;
-        let d = 2.0 * r * ax.max(ay);
+        let d = 2.0 * r * crate::math::fx::max(ax, ay);
         d.is_finite().then_some(d)
     }
 

@@ -54,7 +54,7 @@
 
 use crate::config::Error;
 use crate::cull::{Eye, MARGIN};
-use crate::math::Mat4;
+use crate::math::{fx, Mat4};
 use crate::mesh::BoundingSphere;
 
 /// The most partitions a side of the direction cube (`N`).
@@ -273,9 +273,7 @@ impl BackMask {
         // The margin: every skipped normal at least MARGIN (as a sine)
         // past edge-on against each corner's direction.
         let gmax = dirs.iter().fold(0.0f32, |m, d| {
-            m.max(crate::math::fx::sqrt(
-                d[0] * d[0] + d[1] * d[1] + d[2] * d[2],
-            ))
+            fx::max(m, fx::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
         });
         let least = SQRT_3_UP * MARGIN * gmax * (1.0 + ROUNDING);
         let mut mask = BackMask::EMPTY;
@@ -290,7 +288,7 @@ impl BackMask {
             let at = |i: usize, j: usize| -> (f32, f32) {
                 let (u, v) = (-1.0 + step * i as f32, -1.0 + step * j as f32);
                 let least = dirs.iter().fold(f32::INFINITY, |m, d| {
-                    m.min(sa * d[a] + u * d[ib] + v * d[ic])
+                    fx::min(m, sa * d[a] + u * d[ib] + v * d[ic])
                 });
                 (least - 4.0 * ROUNDING, 1.0 + u * u + v * v)
             };
@@ -303,7 +301,7 @@ impl BackMask {
                 if i > 0 {
                     for j in 0..p {
                         let corners = [prev[j], prev[j + 1], row[j], row[j + 1]];
-                        let delta = corners.iter().fold(f32::INFINITY, |m, c| m.min(c.0));
+                        let delta = corners.iter().fold(f32::INFINITY, |m, c| fx::min(m, c.0));
                         if !(delta > least) {
                             continue;
                         }
@@ -311,8 +309,8 @@ impl BackMask {
                         // A unit normal of the cell is `m / |m|` with `m`
                         // in its rectangle, `|m|` at most the largest
                         // corner's.
-                        let m2 = corners.iter().fold(0.0f32, |m, c| m.max(c.1));
-                        let len = crate::math::fx::sqrt(m2) * (1.0 + ROUNDING);
+                        let m2 = corners.iter().fold(0.0f32, |m, c| fx::max(m, c.1));
+                        let len = fx::sqrt(m2) * (1.0 + ROUNDING);
                         if !guard || class_keeps_winding(set, c, &screen, eye.big, s * delta / len)
                         {
                             if let Some(w) = mask.words.get_mut(c / 32) {
