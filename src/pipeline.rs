@@ -199,6 +199,59 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             mesh,
             mvp,
             first_id,
+            mask: NoMask,
+        };
+        run_job::<S, N, _, _>(parts, &job)
+    }
+
+    /// Like [`Submit::submit_mesh`] (no vertex cache: each triangle's
+    /// vertices are transformed as it is submitted), with the lecture's
+    /// normal masks for a caller that builds the mask itself, once for
+    /// many submissions: a triangle whose class (`classes[i]` for
+    /// triangle `i`) is in `mask` is counted in [`Stats::culled_mask`]
+    /// and nothing of it is read. For firmware that submits a mesh in
+    /// runs, each with its sphere, and has no room for a vertex cache.
+    ///
+    /// `mask` must be this receiver's [`Submit::back_mask`] for the same
+    /// `mvp` and class data, or the mask of a sector that holds this
+    /// receiver's rows (a [`Frame`](crate::Frame)'s, of the whole
+    /// viewport, serves every strip): then the frame is the one
+    /// `submit_mesh` draws. `classes` must hold one class per triangle
+    /// (else [`Error::InvalidNormalClasses`], nothing done); an id beyond
+    /// the mask's classes is never masked. Nothing is masked under
+    /// [`CullMode::None`](crate::CullMode) or in the clipless mode, as
+    /// with [`Submit::submit_masked`].
+    fn submit_mesh_masked<A: Attributes<N>>(
+        &mut self,
+        mesh: &Mesh<'_, A>,
+        mvp: &Mat4,
+        classes: &[u16],
+        mask: &BackMask,
+        first_id: u32,
+    ) -> Result<(), Error> {
+        let n = check_mesh_len(mesh.indices.len())?;
+        if classes.len() != mesh.indices.len() {
+            return Err(Error::InvalidNormalClasses(
+                crate::normal_mask::ClassFault::Triangles,
+            ));
+        }
+        let config = &self.stage().config;
+        let mask = if config.cull == crate::config::CullMode::None
+            || config.mode == RasterMode::Clipless
+        {
+            &BackMask::EMPTY
+        } else {
+            mask
+        };
+        let mut parts = self.parts();
+        if culled_object::<S, N, _, _>(&mut parts, mesh, mvp, n, first_id)? {
+            return Ok(());
+        }
+        let job = MeshJob {
+            mesh,
+            mvp,
+            first_id,
+            mask: ClassMask { classes, mask },
         };
         run_job::<S, N, _, _>(parts, &job)
     }
@@ -314,6 +367,24 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         run_job::<S, N, _, _>(self.parts(), &job)
     }
 
+    /// The [`BackMask`] that [`Submit::submit_masked`] applies to a mesh
+    /// drawn with `mvp` and classified by `classes`: of the receiver's
+    /// rows for a strip renderer (its sector), of the whole viewport for
+    /// a [`Frame`](crate::Frame); empty in the clipless mode. For firmware
+    /// that submits a mesh in runs without a vertex cache: a triangle of a
+    /// class in the mask may be left out of the runs, and the frame is the
+    /// same (as `submit_masked` leaves it out). Its classes are not
+    /// checked against a mesh here ([`NormalClasses::validate`]).
+    fn back_mask(&self, mvp: &Mat4, classes: &NormalClasses<'_>) -> BackMask {
+        let stage = self.stage();
+        match stage.config.mode {
+            RasterMode::Clipping => {
+                BackMask::for_frame::<S>(mvp, &stage.config, stage.slab, classes)
+            }
+            RasterMode::Clipless => BackMask::EMPTY,
+        }
+    }
+
     /// Like [`Submit::submit_mesh_cached`], with the lecture's normal
     /// masks (see [`crate::normal_mask`]): a triangle whose normal class
     /// is in this frame's [`BackMask`] (of the receiver's strip, for a
@@ -340,13 +411,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         if culled_object::<S, N, _, _>(&mut self.parts(), mesh, mvp, n, first_id)? {
             return Ok(());
         }
-        let stage = self.stage();
-        let mask = match stage.config.mode {
-            RasterMode::Clipping => {
-                BackMask::for_frame::<S>(mvp, &stage.config, stage.slab, classes)
-            }
-            RasterMode::Clipless => BackMask::EMPTY,
-        };
+        let mask = self.back_mask(mvp, classes);
         if mask.is_empty() {
             self.process_vertices(mvp, mesh.positions, cache);
             return self.submit_processed_mesh(mesh, first_id, cache);
@@ -657,13 +722,44 @@ impl<const N: usize> Job<N> for TriangleJob<N> {
     }
 }
 
-struct MeshJob<'m, A> {
+struct MeshJob<'m, A, M> {
     mesh: &'m Mesh<'m, A>,
     mvp: &'m Mat4,
     first_id: u32,
+    /// Which triangles are skipped unread ([`NoMask`]: none, compiled
+    /// out).
+    mask: M,
 }
 
-impl<const N: usize, A: Attributes<N>> Job<N> for MeshJob<'_, A> {
+/// Which triangles of a [`MeshJob`] are masked by normal class.
+trait TriangleMask {
+    fn masked(&self, i: usize) -> bool;
+}
+
+/// No triangle.
+struct NoMask;
+
+impl TriangleMask for NoMask {
+    #[inline(always)]
+    fn masked(&self, _: usize) -> bool {
+        false
+    }
+}
+
+/// The triangles whose class is in the mask.
+struct ClassMask<'m> {
+    classes: &'m [u16],
+    mask: &'m BackMask,
+}
+
+impl TriangleMask for ClassMask<'_> {
+    #[inline(always)]
+    fn masked(&self, i: usize) -> bool {
+        self.classes.get(i).is_some_and(|&c| self.mask.contains(c))
+    }
+}
+
+impl<const N: usize, A: Attributes<N>, M: TriangleMask> Job<N> for MeshJob<'_, A, M> {
     fn max_pieces(&self) -> usize {
         self.mesh.indices.len().saturating_mul(MAX_PIECES)
     }
@@ -680,6 +776,10 @@ impl<const N: usize, A: Attributes<N>> Job<N> for MeshJob<'_, A> {
         let (gx, gy) = stage.guard;
         for (i, &idx) in mesh.indices.iter().enumerate() {
             stats.submitted += 1;
+            if self.mask.masked(i) {
+                stats.culled_mask += 1;
+                continue;
+            }
             let p = idx.map(|k| mesh.positions.get(k as usize));
             let (Some(p0), Some(p1), Some(p2)) = (p[0], p[1], p[2]) else {
                 stats.rejected_index += 1;

@@ -54,7 +54,8 @@ pub struct Stats {
     /// is below [`Config::detail`](crate::Config::detail) pixels across.
     pub culled_detail: u64,
     /// Skipped before transform because its normal's class is in the
-    /// frame's back mask ([`Submit::submit_masked`](crate::Submit::submit_masked)).
+    /// frame's back mask ([`Submit::submit_masked`](crate::Submit::submit_masked),
+    /// [`Submit::submit_mesh_masked`](crate::Submit::submit_mesh_masked)).
     pub culled_mask: u64,
     /// Skipped before transform because the strip's hi-z hides its object
     /// ([`Occluder`](crate::occlusion::Occluder)).

@@ -937,7 +937,7 @@ pub fn submit_prep<const S: u32, R: Submit<S>>(r: &mut R, p: &Prep, way: Way) ->
 }
 
 /// `b - a` field by field (a counter that went down overflows: a finding).
-fn diff(a: &Stats, b: &Stats) -> Stats {
+pub(crate) fn diff(a: &Stats, b: &Stats) -> Stats {
     Stats {
         submitted: b.submitted - a.submitted,
         culled_object: b.culled_object - a.culled_object,

@@ -154,7 +154,6 @@ pub fn run_occlusion(input: &OcclusionInput) {
                     .ok()?;
             }
         }
-        drop(r);
         Some((color, depth))
     };
     let culled = draw(true);

@@ -2,7 +2,9 @@
 //! meshes in `assets/models` (bunny, teapot, Spot), at both subpixel
 //! precisions and several partitions: the frame (colour and depth) is
 //! byte-identical, drawn whole ([`Frame`]) or strip by strip with each
-//! strip's own mask ([`StripRenderer`], the lecture's sectors); every
+//! strip's own mask ([`StripRenderer`], the lecture's sectors), with a
+//! vertex cache (`submit_masked`) or without one (`submit_mesh_masked`,
+//! the firmware's way, with the strip's mask or the whole frame's); every
 //! piece the masked path sets up is one the per-triangle path sets up, in
 //! order, and every triangle is counted once.
 
@@ -73,12 +75,41 @@ fn draw<const S: u32>(
     (bytes(&color, &depth), frame.stats(), ids)
 }
 
+/// How `draw_strips` submits the mesh to each strip.
+#[derive(Clone, Copy)]
+enum Way {
+    /// `submit_mesh_cached`, no mask.
+    Cached,
+    /// `submit_masked` (the strip's mask, built by the submission).
+    Masked,
+    /// `submit_mesh_masked` with the strip's own `back_mask`.
+    Uncached,
+    /// `submit_mesh_masked` with the whole frame's mask (a `Frame`'s
+    /// `back_mask`), for every strip.
+    UncachedFrameMask,
+}
+
 /// The frame drawn strip by strip (each strip submits the mesh again,
 /// with its own mask), and the stats summed over the strips.
 fn draw_strips<const S: u32>(
     m: &ClusteredMesh,
     mvp: &Mat4,
     classes: Option<&NormalClassData>,
+) -> (Vec<u8>, Stats) {
+    let way = if classes.is_some() {
+        Way::Masked
+    } else {
+        Way::Cached
+    };
+    draw_strips_by::<S>(m, mvp, classes, way)
+}
+
+/// [`draw_strips`], each strip's submission made `way`.
+fn draw_strips_by<const S: u32>(
+    m: &ClusteredMesh,
+    mvp: &Mat4,
+    classes: Option<&NormalClassData>,
+    way: Way,
 ) -> (Vec<u8>, Stats) {
     let colors = colors(m);
     let mesh = mesh(m, &colors);
@@ -87,6 +118,12 @@ fn draw_strips<const S: u32>(
     let mut stats = Stats::default();
     let mut cache = vec![ProcessedVertex::default(); m.positions.len()];
     let rows = (W * STRIP) as usize;
+    let frame_mask = classes.map(|cl| {
+        let mut st = [SetupTriangle::EMPTY; 1];
+        Frame::<S>::with_subpixel_bits(Config::new(W, H), &mut st)
+            .unwrap()
+            .back_mask(mvp, &cl.set())
+    });
     for (k, (c, d)) in color
         .chunks_mut(rows)
         .zip(depth.chunks_mut(rows))
@@ -96,11 +133,21 @@ fn draw_strips<const S: u32>(
         let y1 = (y0 + STRIP).min(H);
         let mut r =
             StripRenderer::<_, _, S>::with_subpixel_bits(Config::new(W, H), y0, y1, c, d).unwrap();
-        match classes {
-            None => r.submit_mesh_cached(&mesh, mvp, 0, &mut cache).unwrap(),
-            Some(cl) => r
+        match (classes, way) {
+            (Some(cl), Way::Masked) => r
                 .submit_masked(&mesh, mvp, &cl.set(), 0, &mut cache)
                 .unwrap(),
+            (Some(cl), Way::Uncached) => {
+                let mask = r.back_mask(mvp, &cl.set());
+                r.submit_mesh_masked(&mesh, mvp, &cl.classes, &mask, 0)
+                    .unwrap()
+            }
+            (Some(cl), Way::UncachedFrameMask) => {
+                let mask = frame_mask.unwrap();
+                r.submit_mesh_masked(&mesh, mvp, &cl.classes, &mask, 0)
+                    .unwrap()
+            }
+            _ => r.submit_mesh_cached(&mesh, mvp, 0, &mut cache).unwrap(),
         }
         stats += r.stats();
     }
@@ -138,6 +185,19 @@ fn check<const S: u32>(which: usize, partitions: u8, mvp: &Mat4) -> (u64, u64) {
         got_s == want_s,
         "strip masks of {partitions} changed the frame"
     );
+    // Without a cache: the same frame and the same triangles masked with
+    // the strips' own masks; the whole frame's mask masks no more.
+    let (got_u, u_stats) = draw_strips_by::<S>(m, mvp, Some(&c), Way::Uncached);
+    assert!(got_u == want_s, "submit_mesh_masked changed the frame");
+    assert_eq!(u_stats.culled_mask, strip_stats.culled_mask);
+    assert_eq!(u_stats.submitted, strip_stats.submitted);
+    let (got_f, f_stats) = draw_strips_by::<S>(m, mvp, Some(&c), Way::UncachedFrameMask);
+    assert!(got_f == want_s, "the frame's mask changed a strip");
+    assert_eq!(
+        f_stats.culled_mask,
+        stats.culled_mask * H.div_ceil(STRIP) as u64
+    );
+    assert!(f_stats.culled_mask <= u_stats.culled_mask);
     (stats.culled_mask, strip_stats.culled_mask)
 }
 
