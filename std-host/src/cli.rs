@@ -850,6 +850,12 @@ pub struct BakeArgs {
     /// culling, over the same baked vertices (default cluster options).
     #[arg(long)]
     pub clusters: bool,
+
+    /// Also write `<model>_classes.rs`: each triangle's normal class on a
+    /// direction cube of N partitions a side (1 to 16) and the classes'
+    /// size bounds and spheres, for normal masks (`BackMask`).
+    #[arg(long, value_name = "N")]
+    pub normal_masks: Option<u8>,
 }
 
 /// The models `cull` measures by default (in the repository).

@@ -609,3 +609,76 @@ fn bake_clusters_writes_both_files_or_neither() {
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(std::fs::read_dir(empty.path()).unwrap().count(), 0);
 }
+
+/// `bake --normal-masks N`: the classes file holds `normal_mask::build`'s
+/// classes for the model file's triangles in their order, its sizes and
+/// spheres (bit for bit), and is written with the model or not at all.
+#[test]
+fn the_classes_bake_is_normal_mask_build_of_the_models_triangles() {
+    let mesh = load_obj_shaded(&models().join("spot.obj"), None).unwrap();
+    let opts = BakeOptions {
+        max_triangles: Some(600),
+        ..spot_opts()
+    };
+    let (model, _) = bake_source(&mesh, "spot", "spot", &opts).unwrap();
+    let decimated = decimate(&mesh, 600).unwrap();
+    let src = bake::classes_source(&decimated, "spot", &opts, 4).unwrap();
+    let positions: Vec<microraster::Vec3> = decimated
+        .positions
+        .iter()
+        .map(|p| microraster::Vec3::new(p[0], p[1], p[2]))
+        .collect();
+    assert_eq!(triangles_of(&model, "INDICES"), decimated.indices);
+    let want = microraster_host::normal_mask::build(&positions, &decimated.indices, 4).unwrap();
+    let body = |name: &str| -> Vec<String> {
+        let start = src.find(&format!("pub static {name}:")).unwrap();
+        let b = &src[start..];
+        let open = b.find("= [").unwrap() + 3;
+        let close = open + b[open..].find("\n];").unwrap();
+        b[open..close]
+            .split(|c: char| c == ',' || c.is_whitespace() || c == '[' || c == ']')
+            .filter(|x| !x.is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    let classes: Vec<u16> = body("CLASSES").iter().map(|x| x.parse().unwrap()).collect();
+    assert_eq!(classes, want.classes);
+    let sizes: Vec<f32> = body("CLASS_SIZES")
+        .iter()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let want_sizes: Vec<f32> = want.sizes.iter().flatten().copied().collect();
+    assert_eq!(
+        sizes.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        want_sizes.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    assert_eq!(
+        src.matches("microraster::BoundingSphere {").count(),
+        6 * 4 * 4
+    );
+    assert!(src.contains("pub const PARTITIONS: u8 = 4;"));
+    assert!(src.contains("pub const CLASS_COUNT: usize = 96;"));
+    // Partitions beyond 16 are refused, and nothing is written.
+    let empty = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_microraster"))
+        .arg("bake")
+        .arg(models().join("spot.obj"))
+        .args(["--max-triangles", "400", "--normal-masks", "17", "--out"])
+        .arg(empty.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("partitions"));
+    assert_eq!(std::fs::read_dir(empty.path()).unwrap().count(), 0);
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_microraster"))
+        .arg("bake")
+        .arg(models().join("spot.obj"))
+        .args(["--max-triangles", "400", "--normal-masks", "8", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.path().join("spot.rs").is_file());
+    assert!(dir.path().join("spot_classes.rs").is_file());
+}
