@@ -42,11 +42,12 @@ step "baked Spot is what microraster bake writes today (examples/firmware/baked)
 cargo build -q --release -p microraster-host
 bake=$(mktemp -d)
 target/release/microraster bake --out "$bake/full" --texture assets/models/spot_texture.png \
-  --texture-size 256 --clusters assets/models/spot.obj >/dev/null
+  --texture-size 256 --clusters --normal-masks 8 assets/models/spot.obj >/dev/null
 target/release/microraster bake --out "$bake/small" --texture assets/models/spot_texture.png \
   --texture-size 128 --max-triangles 1500 assets/models/spot.obj >/dev/null
 diff -q "$bake/full/spot.rs" examples/firmware/baked/spot.rs
 diff -q "$bake/full/spot_clusters.rs" examples/firmware/baked/spot_clusters.rs
+diff -q "$bake/full/spot_classes.rs" examples/firmware/baked/spot_classes.rs
 diff -q "$bake/small/spot.rs" examples/firmware/baked/small/spot.rs
 rm -r "$bake"
 echo "baked Spot up to date"
@@ -70,6 +71,9 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
   done
   # Cluster culling of Spot: the MPS2 boards only (all of Spot).
   cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-volumes -- -D warnings
+  # Normal masks of Spot, likewise.
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-masks -- -D warnings
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,cull-masks-frame -- -D warnings
 )
 
 expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
@@ -390,6 +394,20 @@ for v in "${cluster_variants[@]}"; do
   check_sweep mps2-an386 "$v (sweep)" "$culled $every" || failed=1
 done
 
+# Normal masks of Spot (issue 11) on the M4F: the Morton order of the
+# shading rows, each strip's own mask (its rows, the lecture's sectors)
+# or one mask a frame; each frame must be the unmasked one
+# (host-checksums.txt), counts of record in docs/embedded.md.
+mask_variants=(spot-flat,cull-masks spot-flat,cull-masks-frame spot-lit,cull-masks spot-lit,cull-masks-frame)
+mask_rows=()
+for v in "${mask_variants[@]}"; do
+  spot_run thumbv7em-none-eabihf mps2-an386 "$v" "${v%%,*}" mask_rows || continue
+  if ! grep -qE '^normal masks .*: masked [1-9]' "$out"; then
+    echo "FAIL: mps2-an386 $v masked no triangle"
+    failed=1
+  fi
+done
+
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
 # the M0, bit-identical to the host's clipless frame, counts of record in
 # docs/embedded.md like the rows above.
@@ -448,6 +466,11 @@ step "Spot, cluster culling on the M4F (the same table in docs/embedded.md and d
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${cluster_rows[@]}"
+
+step "Spot, normal masks on the M4F (the same table in docs/embedded.md)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${mask_rows[@]}"
 
 step "Spot, cluster culling on the M4F, camera sweep (the same table in docs/embedded.md)"
 echo "| board | build | cameras | skipped before transform, mean | fewest-most | render a frame, culled | with every cluster | culled / every |"

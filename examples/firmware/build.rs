@@ -76,6 +76,14 @@ mod spot_clusters {
     include!("baked/spot_clusters.rs");
 }
 
+/// Spot's normal classes in the baked order (`microraster bake
+/// --normal-masks 8`), for `cull-masks`.
+#[cfg(feature = "cull-masks")]
+#[allow(dead_code)]
+mod spot_classes {
+    include!("baked/spot_classes.rs");
+}
+
 /// The order of Spot's triangles: Morton order of their centroids (see
 /// [`morton_order`]), or with `clusters` the baked cluster order.
 #[cfg(feature = "spot")]
@@ -469,6 +477,26 @@ fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
         .unwrap();
     }
     s.push_str("];\n");
+    #[cfg(feature = "cull-masks")]
+    s.push_str(&spot_classes_reordered(model.indices));
+    s
+}
+
+/// `CLASSES`: each triangle's normal class (`baked/spot_classes.rs`, in
+/// the baked order) for the triangles in the order drawn.
+#[cfg(feature = "cull-masks")]
+fn spot_classes_reordered(indices: &[[u32; 3]]) -> String {
+    let baked: std::collections::HashMap<[u32; 3], u16> = spot_full::INDICES
+        .iter()
+        .copied()
+        .zip(spot_classes::CLASSES.iter().copied())
+        .collect();
+    let mut s = String::from("/// Each triangle's normal class, in the order drawn (build.rs).\n");
+    writeln!(s, "pub static CLASSES: [u16; {}] = [", indices.len()).unwrap();
+    for t in indices {
+        writeln!(s, "    {},", baked[t]).unwrap();
+    }
+    s.push_str("];\n");
     s
 }
 
@@ -482,6 +510,9 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(small_spot)");
     if spot && small {
         println!("cargo::rustc-cfg=small_spot");
+    }
+    if small && cfg!(feature = "cull-masks") {
+        panic!("`cull-masks` is for the MPS2 boards (all of Spot)");
     }
     if small && cfg!(feature = "clusters") {
         panic!(

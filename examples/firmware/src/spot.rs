@@ -34,6 +34,8 @@ use embedded_graphics_core::primitives::Rectangle;
 #[cfg(feature = "clusters")]
 use microraster::cull::{Eye, Visit};
 use microraster::pixelcolor::{Rgb565, RgbColor};
+#[cfg(feature = "cull-masks")]
+use microraster::NormalClasses;
 use microraster::StripSink;
 use microraster::{Attributes, Config, FragmentShader, Mat4, Mesh, StripRenderer, Submit};
 #[cfg(feature = "clusters")]
@@ -71,6 +73,27 @@ mod clustered {
 
 #[cfg(all(feature = "clusters", small_spot))]
 compile_error!("the `clusters` features are for the MPS2 boards (all of Spot)");
+#[cfg(all(feature = "cull-masks", feature = "clusters"))]
+compile_error!("`cull-masks` draws the Morton order, not the clusters");
+
+/// Spot's normal classes (`microraster bake --normal-masks 8`): the
+/// direction cube and the classes' size bounds and spheres; `chunks`
+/// holds each triangle's class in the order drawn.
+#[cfg(feature = "cull-masks")]
+#[allow(dead_code)]
+mod masks {
+    include!("../baked/spot_classes.rs");
+}
+
+#[cfg(feature = "cull-masks")]
+fn normal_classes() -> NormalClasses<'static> {
+    NormalClasses {
+        partitions: masks::PARTITIONS,
+        classes: &chunks::CLASSES,
+        sizes: &masks::CLASS_SIZES,
+        spheres: &masks::CLASS_SPHERES,
+    }
+}
 
 #[cfg(feature = "clusters")]
 const _: () = assert!(
@@ -115,7 +138,13 @@ const CULL_NAME: &str = if cfg!(feature = "cull-volumes") {
     "in cluster order, each triangle culled on its own"
 };
 #[cfg(not(feature = "clusters"))]
-const CULL_NAME: &str = "in Morton order";
+const CULL_NAME: &str = if cfg!(feature = "cull-masks-frame") {
+    "in Morton order, one normal mask a frame"
+} else if cfg!(feature = "cull-masks") {
+    "in Morton order, normal masks of each strip's rows"
+} else {
+    "in Morton order"
+};
 
 #[cfg(feature = "clusters")]
 fn cluster_set() -> ClusterSet<'static> {
@@ -138,7 +167,10 @@ fn cluster_eye(mvp: &Mat4, config: &Config) -> Option<Eye> {
 /// nothing without `clusters`).
 #[cfg(feature = "clusters")]
 type Drawn = [u32; clustered::CLUSTER_COUNT.div_ceil(32)];
-#[cfg(not(feature = "clusters"))]
+/// With `cull-masks-frame`: the frame's normal mask, for every strip.
+#[cfg(feature = "cull-masks-frame")]
+type Drawn = microraster::BackMask;
+#[cfg(not(any(feature = "clusters", feature = "cull-masks-frame")))]
 type Drawn = ();
 
 /// Walks the cluster tree once with `eye` (none: every cluster drawn).
@@ -162,7 +194,9 @@ fn drawn_clusters(eye: Option<&Eye>) -> Drawn {
 fn decide(mvp: &Mat4, config: &Config) -> Drawn {
     #[cfg(feature = "clusters")]
     return drawn_clusters(cluster_eye(mvp, config).as_ref());
-    #[cfg(not(feature = "clusters"))]
+    #[cfg(feature = "cull-masks-frame")]
+    return microraster::BackMask::for_frame::<8>(mvp, config, None, &normal_classes());
+    #[cfg(not(any(feature = "clusters", feature = "cull-masks-frame")))]
     let _ = (mvp, config);
 }
 
@@ -183,6 +217,19 @@ struct Measured {
     /// With `clusters`: what the cluster test did (see `ClusterCount`).
     #[cfg(feature = "clusters")]
     clusters: ClusterCount,
+    /// With `cull-masks`: what the strips' masks did (see `MaskCount`).
+    #[cfg(feature = "cull-masks")]
+    masks: MaskCount,
+}
+
+/// The frame's normal masks, built again on their own after the frame.
+#[cfg(feature = "cull-masks")]
+struct MaskCount {
+    /// Triangles of a class in its strip's mask, summed over the strips.
+    masked: u64,
+    /// Ticks of building the masks: every strip's (`Submit::back_mask`),
+    /// or with `cull-masks-frame` the frame's one.
+    build: u64,
 }
 
 /// The frame's cluster test, measured again on its own.
@@ -298,6 +345,47 @@ impl Draw for Strips<'_> {
             }
         };
 
+        #[cfg(feature = "cull-masks")]
+        let masks = {
+            let (mut masked, mut build) = (0u64, 0u64);
+            let classes = normal_classes();
+            let mut y0 = 0;
+            while y0 < HEIGHT {
+                let y1 = (y0 + STRIP_ROWS as u32).min(HEIGHT);
+                let len = WIDTH as usize * (y1 - y0) as usize;
+                let strip = StripRenderer::<_, _, 8, N, _>::with_shader(
+                    config,
+                    y0,
+                    y1,
+                    &mut color[..len],
+                    &mut depth[..len],
+                    fragment,
+                );
+                if let Ok(strip) = strip {
+                    let t = clock.now();
+                    #[cfg(not(feature = "cull-masks-frame"))]
+                    let mask = strip.back_mask(&mvp, &classes);
+                    #[cfg(feature = "cull-masks-frame")]
+                    let mask = {
+                        let _ = strip;
+                        decide(&mvp, &config)
+                    };
+                    let ticks = clock.now() - t;
+                    // The frame's one mask is built once a frame.
+                    if !cfg!(feature = "cull-masks-frame") || y0 == 0 {
+                        build += ticks;
+                    }
+                    masked += classes
+                        .classes
+                        .iter()
+                        .filter(|&&c| mask.contains(c))
+                        .count() as u64;
+                }
+                y0 = y1;
+            }
+            MaskCount { masked, build }
+        };
+
         Measured {
             written,
             setup_start: t0,
@@ -307,6 +395,8 @@ impl Draw for Strips<'_> {
             one_row,
             #[cfg(feature = "clusters")]
             clusters,
+            #[cfg(feature = "cull-masks")]
+            masks,
         }
     }
 }
@@ -451,7 +541,7 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
 /// transforms their vertices. Triangle ids and order are the whole mesh's.
 /// Inlined: out of line, its frame and `submit_mesh`'s took 860 bytes more
 /// stack (`spot-phong` on the Cortex-M3 overflowed its 24 KB).
-#[cfg(not(feature = "clusters"))]
+#[cfg(not(any(feature = "clusters", feature = "cull-masks")))]
 #[inline(always)]
 fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
     strip: &mut S,
@@ -468,6 +558,46 @@ fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
         };
         let first = (k * spot_scene::CHUNK_TRIANGLES) as u32;
         strip.submit_mesh(&run, mvp, first).map_err(|_| "submit")?;
+    }
+    Ok(())
+}
+
+/// With `cull-masks`: the Morton runs as without it, each through
+/// `Submit::submit_mesh_masked` with its classes and the strip's normal
+/// mask (`Submit::back_mask`, of the strip's rows; with
+/// `cull-masks-frame` the frame's, in `drawn`): a triangle of a class in
+/// the mask is skipped unread. A masked triangle is culled by winding
+/// wherever it shows in the strip (the mask's guarantee), so the frame is
+/// the one drawn without masks.
+#[cfg(all(feature = "cull-masks", not(feature = "clusters")))]
+#[inline(always)]
+fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
+    strip: &mut S,
+    mesh: &Mesh<'_, A>,
+    mvp: &Mat4,
+    drawn: &Drawn,
+) -> Result<(), &'static str> {
+    #[cfg(not(feature = "cull-masks-frame"))]
+    let mask = &{
+        let _ = drawn;
+        strip.back_mask(mvp, &normal_classes())
+    };
+    #[cfg(feature = "cull-masks-frame")]
+    let mask = drawn;
+    let runs = mesh
+        .indices
+        .chunks(spot_scene::CHUNK_TRIANGLES)
+        .zip(chunks::CLASSES.chunks(spot_scene::CHUNK_TRIANGLES));
+    for (k, ((indices, classes), bounds)) in runs.zip(chunks::CHUNKS.iter()).enumerate() {
+        let run = Mesh {
+            indices,
+            bounds: Some(*bounds),
+            ..*mesh
+        };
+        let first = (k * spot_scene::CHUNK_TRIANGLES) as u32;
+        strip
+            .submit_mesh_masked(&run, mvp, classes, mask, first)
+            .map_err(|_| "submit")?;
     }
     Ok(())
 }
@@ -551,6 +681,12 @@ fn main() -> ! {
         .is_err()
     {
         hprintln!("FAIL: the baked cluster set does not fit the mesh");
+        exit(false)
+    }
+
+    #[cfg(feature = "cull-masks")]
+    if normal_classes().validate(model.indices.len()).is_err() {
+        hprintln!("FAIL: the baked normal classes do not fit the mesh");
         exit(false)
     }
 
@@ -720,6 +856,28 @@ fn main() -> ! {
             );
             exit(false)
         }
+    }
+    #[cfg(feature = "cull-masks")]
+    {
+        let c = &m.masks;
+        let total = model.indices.len() as u64 * strips;
+        let (a, b) = ratio(c.masked * 100, total);
+        hprintln!(
+            "normal masks (N = {}, {} classes, {}): masked {} of {} triangles over the {} strips ({}.{} %), built in {} instructions a frame",
+            masks::PARTITIONS,
+            masks::CLASS_COUNT,
+            if cfg!(feature = "cull-masks-frame") {
+                "one a frame"
+            } else {
+                "one a strip"
+            },
+            c.masked,
+            total,
+            strips,
+            a,
+            b,
+            instr(c.build)
+        );
     }
     match stack {
         Some(s) => hprintln!(
