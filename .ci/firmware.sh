@@ -42,7 +42,7 @@ step "baked Spot is what microraster bake writes today (examples/firmware/baked)
 cargo build -q --release -p microraster-host
 bake=$(mktemp -d)
 target/release/microraster bake --out "$bake/full" --texture assets/models/spot_texture.png \
-  --texture-size 256 --clusters --normal-masks 8 assets/models/spot.obj >/dev/null
+  --texture-size 256 --clusters --normal-masks 16 assets/models/spot.obj >/dev/null
 target/release/microraster bake --out "$bake/small" --texture assets/models/spot_texture.png \
   --texture-size 128 --max-triangles 1500 assets/models/spot.obj >/dev/null
 diff -q "$bake/full/spot.rs" examples/firmware/baked/spot.rs

@@ -77,7 +77,7 @@ mod spot_clusters {
 }
 
 /// Spot's normal classes in the baked order (`microraster bake
-/// --normal-masks 8`), for `cull-masks`.
+/// --normal-masks 16`), for `cull-masks`.
 #[cfg(feature = "cull-masks")]
 #[allow(dead_code)]
 mod spot_classes {

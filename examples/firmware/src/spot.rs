@@ -76,7 +76,7 @@ compile_error!("the `clusters` features are for the MPS2 boards (all of Spot)");
 #[cfg(all(feature = "cull-masks", feature = "clusters"))]
 compile_error!("`cull-masks` draws the Morton order, not the clusters");
 
-/// Spot's normal classes (`microraster bake --normal-masks 8`): the
+/// Spot's normal classes (`microraster bake --normal-masks 16`): the
 /// direction cube and the classes' size bounds and spheres; `chunks`
 /// holds each triangle's class in the order drawn.
 #[cfg(feature = "cull-masks")]
