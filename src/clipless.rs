@@ -539,6 +539,11 @@ pub(crate) fn draw<
             }
         }
     }
+    if strip.track && written != 0 {
+        // Every pixel written lies in the clamped box.
+        let (x0, x1) = (col_first as u32, col_last as u32);
+        strip.touched.add(x0, x1, row_first, row_last);
+    }
     written
 }
 

@@ -38,6 +38,8 @@ use crate::config::{Config, Error};
 use crate::depth::{DepthBuffer, DepthWord, NoDepth};
 use crate::fixed::SUBPIXEL_BITS;
 use crate::frame::Frame;
+use crate::raster::Touched;
+use crate::shade::VertexColor;
 use crate::stats::RenderStats;
 use crate::strip_renderer::StripRenderer;
 use embedded_graphics_core::draw_target::DrawTarget;
@@ -178,6 +180,98 @@ pub trait StripDepth {
         color.fill(background);
         Some(rows)
     }
+
+    /// The first `len` values, after the rectangle `rect = [x0, x1, r0,
+    /// r1]` (columns `x0..x1` of rows `r0..r1`, `width` values a row; it
+    /// may reach past `len`) is set to the depth `z32`, and the same
+    /// values of `color` to `background`: [`StripDrawer`]'s clear of what
+    /// the last strip wrote, where everything else already holds those
+    /// values. `None` (nothing cleared) if fewer than `len` are held. The
+    /// default ignores the rectangle and clears as
+    /// [`StripDepth::cleared_with`], which is always right.
+    fn cleared_rect<P: Copy>(
+        &mut self,
+        len: usize,
+        z32: u32,
+        color: &mut [P],
+        background: P,
+        width: usize,
+        rect: [usize; 4],
+    ) -> Option<&mut Self::Rows> {
+        let _ = (width, rect);
+        self.cleared_with(len, z32, color, background)
+    }
+}
+
+/// The values of the rectangle `[x0, x1, r0, r1]` of a layout `width`
+/// values a row set to `v`, as far as `buf` reaches: one run where the
+/// rectangle spans whole rows, else a run a row.
+#[inline]
+fn clear_rect<T: Copy>(buf: &mut [T], v: T, width: usize, [x0, x1, r0, r1]: [usize; 4]) {
+    if x0 == 0 && x1 == width {
+        let end = (r1 * width).min(buf.len());
+        if let Some(run) = buf.get_mut(r0 * width..end) {
+            fill8(run, v);
+        }
+        return;
+    }
+    for r in r0..r1 {
+        let end = (r * width + x1).min(buf.len());
+        if let Some(run) = buf.get_mut(r * width + x0..end) {
+            fill8(run, v);
+        }
+    }
+}
+
+/// `buf.fill(v)`, in blocks of eight (as `clear_both`).
+#[inline]
+fn fill8<T: Copy>(buf: &mut [T], v: T) {
+    let mut b8 = buf.chunks_exact_mut(8);
+    for b in &mut b8 {
+        b.fill(v);
+    }
+    b8.into_remainder().fill(v);
+}
+
+/// [`StripDepth::cleared_rect`] of both slice impls: the rectangle of
+/// `depth` and `color` (in one pass where it spans whole rows).
+fn clear_rect_prefix<'a, W: DepthWord, P: Copy>(
+    depth: &'a mut [W],
+    len: usize,
+    z32: u32,
+    (color, background): (&mut [P], P),
+    width: usize,
+    rect: [usize; 4],
+) -> Option<&'a mut [W]> {
+    if depth.len() < len {
+        return None;
+    }
+    let z = W::from_z32(z32);
+    let [x0, x1, r0, r1] = rect;
+    if x0 == 0 && x1 == width {
+        if let (Some(d), Some(c)) = (depth.get_mut(..r1 * width), color.get_mut(..r1 * width)) {
+            let (d, c) = (&mut d[r0 * width..], &mut c[r0 * width..]);
+            clear_both(d, z, c, background);
+            return depth.get_mut(..len);
+        }
+    } else {
+        let mut ok = true;
+        for r in r0..r1 {
+            let run = r * width + x0..r * width + x1;
+            match (depth.get_mut(run.clone()), color.get_mut(run)) {
+                (Some(d), Some(c)) => clear_both(d, z, c, background),
+                _ => ok = false,
+            }
+        }
+        if ok {
+            return depth.get_mut(..len);
+        }
+    }
+    // A rectangle past either buffer (the drawer never asks for one):
+    // as far as each reaches.
+    clear_rect(depth, z, width, rect);
+    clear_rect(color, background, width, rect);
+    depth.get_mut(..len)
 }
 
 /// The first `len` values of `depth` set to `z32` (and `color` filled, in
@@ -236,6 +330,17 @@ impl<W: DepthWord> StripDepth for &mut [W] {
     ) -> Option<&mut [W]> {
         clear_prefix(&mut self[..], len, z32, Some((color, background)))
     }
+    fn cleared_rect<P: Copy>(
+        &mut self,
+        len: usize,
+        z32: u32,
+        color: &mut [P],
+        background: P,
+        width: usize,
+        rect: [usize; 4],
+    ) -> Option<&mut [W]> {
+        clear_rect_prefix(&mut self[..], len, z32, (color, background), width, rect)
+    }
 }
 
 impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
@@ -254,6 +359,17 @@ impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
         background: P,
     ) -> Option<&mut [W]> {
         clear_prefix(&mut self[..], len, z32, Some((color, background)))
+    }
+    fn cleared_rect<P: Copy>(
+        &mut self,
+        len: usize,
+        z32: u32,
+        color: &mut [P],
+        background: P,
+        width: usize,
+        rect: [usize; 4],
+    ) -> Option<&mut [W]> {
+        clear_rect_prefix(&mut self[..], len, z32, (color, background), width, rect)
     }
 }
 
@@ -281,6 +397,29 @@ impl StripDepth for NoDepth {
             p.fill(background);
         }
         c8.into_remainder().fill(background);
+        Some(self)
+    }
+    fn cleared_rect<P: Copy>(
+        &mut self,
+        _: usize,
+        _: u32,
+        color: &mut [P],
+        background: P,
+        width: usize,
+        rect: [usize; 4],
+    ) -> Option<&mut NoDepth> {
+        // Each run by `cleared_with`'s loop (a shared `fill` costs more).
+        let [x0, x1, r0, r1] = rect;
+        let runs = match x0 == 0 && x1 == width {
+            true => (0..1, r0 * width..r1 * width),
+            false => (r0..r1, x0..x1),
+        };
+        for r in runs.0 {
+            let (a, b) = (r * width + runs.1.start, r * width + runs.1.end);
+            if let Some(run) = color.get_mut(a..b.min(color.len())) {
+                self.cleared_with(0, 0, run, background);
+            }
+        }
         Some(self)
     }
 }
@@ -328,6 +467,12 @@ pub struct StripDrawer<'b, P, D> {
     background: P,
     clear_z32: u32,
     origin: Point,
+    /// `Some((width, rect))`: laid out `width` pixels a row, both buffers
+    /// hold their clear values everywhere but in `rect` (`[x0, x1, r0,
+    /// r1]`, what the last strip wrote); `None`: unknown.
+    clean: Option<(usize, [usize; 4])>,
+    /// Pixels cleared so far.
+    cleared: u64,
 }
 
 impl<P, D> core::fmt::Debug for StripDrawer<'_, P, D> {
@@ -351,6 +496,8 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             background,
             clear_z32: u32::MAX,
             origin: Point::zero(),
+            clean: None,
+            cleared: 0,
         }
     }
 
@@ -365,7 +512,18 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
     /// for [`DepthFunc::Greater`](crate::DepthFunc::Greater).
     pub fn with_clear_depth(mut self, z32: u32) -> Self {
         self.clear_z32 = z32;
+        self.clean = None;
         self
+    }
+
+    /// Pixels cleared so far (colour and depth, each pixel once). A strip
+    /// is cleared where the strip before it wrote, not whole: the buffers
+    /// are the drawer's alone, so everything else still holds the
+    /// background and the far depth. The first strip after
+    /// [`StripDrawer::new`], a change of frame width or
+    /// [`StripDrawer::draw_frame_tiles`] clears every row the buffers hold.
+    pub fn pixels_cleared(&self) -> u64 {
+        self.cleared
     }
 
     /// The rows per strip for a frame `width` pixels wide (0 if the colour
@@ -410,8 +568,9 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         self.for_each_strip(target, config, |y0, y1, color, depth| {
             let mut strip =
                 StripRenderer::<P, D::Rows, S>::with_subpixel_bits(config, y0, y1, color, depth)?;
+            strip.track_touched();
             scene(&mut strip);
-            Ok(strip.render_stats())
+            Ok((strip.render_stats(), strip.touched()))
         })
     }
 
@@ -435,8 +594,9 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             let mut strip = StripRenderer::<P, D::Rows, S, N, Sh>::with_shader(
                 config, y0, y1, color, depth, fragment,
             )?;
+            strip.track_touched();
             scene(&mut strip);
-            Ok(strip.render_stats())
+            Ok((strip.render_stats(), strip.touched()))
         })
     }
 
@@ -450,8 +610,9 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
     where
         T: StripSink<P>,
     {
+        let width = frame.config().width;
         self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
-            frame.render_rows(y0, y1, color, depth)
+            frame.render_rect_touched([0, width, y0, y1], color, depth, &VertexColor)
         })
     }
 
@@ -494,6 +655,8 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
                 .into());
             }
         }
+        // Tiles lay the buffers out otherwise: cleared whole, as unknown.
+        self.clean = None;
         let mut total = RenderStats::default();
         for t in 0..bins.tiles() {
             let [x0, x1, y0, y1] = bins.rect(t);
@@ -512,6 +675,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
                 }
                 .into());
             };
+            self.cleared = self.cleared.saturating_add(len as u64);
             let stats = frame.render_tile(bins, t, color, depth)?;
             total.pixels_written += stats.pixels_written;
             // Tile corners are below 2^14; saturating keeps an absurd
@@ -538,13 +702,15 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
         T: StripSink<P>,
         F: crate::shade::FragmentShader<N>,
     {
+        let width = frame.config().width;
         self.for_each_strip(target, *frame.config(), |y0, y1, color, depth| {
-            frame.render_rows_shaded(y0, y1, color, depth, fragment)
+            frame.render_rect_touched([0, width, y0, y1], color, depth, fragment)
         })
     }
 
-    /// The strip loop shared by both modes: check, then per strip clear,
-    /// render (`render(y0, y1, color, depth)`) and push.
+    /// The strip loop shared by both modes: check, then per strip clear
+    /// (what the last strip wrote), render (`render(y0, y1, color,
+    /// depth)`, which returns the box of what it wrote) and push.
     fn for_each_strip<T, R>(
         &mut self,
         target: &mut T,
@@ -553,7 +719,7 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
     ) -> Result<RenderStats, DrawError<T::Error>>
     where
         T: StripSink<P>,
-        R: FnMut(u32, u32, &mut [P], &mut D::Rows) -> Result<RenderStats, Error>,
+        R: FnMut(u32, u32, &mut [P], &mut D::Rows) -> Result<(RenderStats, Touched), Error>,
     {
         crate::config::check_size(&config)?;
         let (width, height) = (config.width, config.height);
@@ -581,13 +747,21 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
             let y1 = y0.saturating_add(rows).min(height);
             let len = width as usize * (y1 - y0) as usize;
             let color_len = self.color.len();
-            // Both cleared (in one pass where the depth strip is a slice).
-            let Some((color, depth)) = self.color.get_mut(..len).and_then(|color| {
-                let depth = self
-                    .depth
-                    .cleared_with(len, self.clear_z32, color, self.background)?;
-                Some((color, depth))
-            }) else {
+            // What the last strip wrote, or (unknown) every row held.
+            let w = width as usize;
+            let rect = match self.clean.take() {
+                Some((cw, rect)) if cw == w => rect,
+                _ => [0, w, 0, color_len / w],
+            };
+            let depth = self.depth.cleared_rect(
+                len,
+                self.clear_z32,
+                &mut *self.color,
+                self.background,
+                w,
+                rect,
+            );
+            let (Some(depth), Some(color)) = (depth, self.color.get_mut(..len)) else {
                 // Unreachable: both were checked to hold `full >= len`.
                 return Err(Error::ColorBufferSize {
                     expected: len,
@@ -595,7 +769,14 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
                 }
                 .into());
             };
-            let stats = render(y0, y1, color, depth)?;
+            let cleared = (rect[1] - rect[0]) as u64 * (rect[3] - rect[2]) as u64;
+            self.cleared = self.cleared.saturating_add(cleared);
+            let (stats, touched) = render(y0, y1, color, depth)?;
+            // Columns widened to multiples of eight (the clears' blocks),
+            // so no row ends in a partial block.
+            let [x0, x1, r0, r1] = touched.within([0, width, y0, y1]);
+            let rect = [x0 & !7, ((x1 + 7) & !7).min(w), r0, r1];
+            self.clean = Some((w, rect));
             total.pixels_written += stats.pixels_written;
             // y0 < 2^14; saturating keeps an absurd origin from overflowing.
             let top = Point::new(self.origin.x, self.origin.y.saturating_add(y0 as i32));
@@ -1045,5 +1226,174 @@ mod tests {
             std::format!("{}", DrawError::<&str>::Target("x")),
             "draw target: x"
         );
+    }
+
+    /// What a sequence of draws pushed: the frame's pixels (and how many
+    /// times each was pushed).
+    struct Capture<P> {
+        width: u32,
+        pixels: Vec<Option<P>>,
+    }
+
+    impl<P: Copy> StripSink<P> for Capture<P> {
+        type Error = ();
+        fn push_strip(&mut self, area: &Rectangle, pixels: &[P]) -> Result<(), ()> {
+            let w = area.size.width as usize;
+            for (i, &p) in pixels.iter().enumerate() {
+                let x = area.top_left.x as usize + i % w;
+                let y = area.top_left.y as usize + i / w;
+                let slot = self.pixels.get_mut(y * self.width as usize + x).ok_or(())?;
+                *slot = Some(p);
+            }
+            Ok(())
+        }
+    }
+
+    /// One frame of [`strip_clears_restore_the_background`]: `n` random
+    /// triangles (varied colours, depths, and some off screen) at a seed.
+    fn random_scene(seed: u64, n: usize, mut push: impl FnMut([Vec4; 3], [Rgb888; 3], u32)) {
+        let mut x = seed | 1;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            ((x >> 11) as f64 / (1u64 << 53) as f64) as f32
+        };
+        for id in 0..n as u32 {
+            let mut p = [Vec4::new(0.0, 0.0, 0.0, 1.0); 3];
+            let (cx, cy, r) = (rnd() * 2.4 - 1.2, rnd() * 2.4 - 1.2, rnd() * 0.8);
+            for q in p.iter_mut() {
+                *q = Vec4::new(
+                    cx + (rnd() - 0.5) * r,
+                    cy + (rnd() - 0.5) * r,
+                    rnd() * 1.6 - 0.8,
+                    1.0,
+                );
+            }
+            let c = |k: f32| Rgb888::new((k * 255.0) as u8, 255 - (k * 200.0) as u8, 40);
+            push(p, [c(rnd()), c(rnd()), c(rnd())], id);
+        }
+    }
+
+    /// The drawer clears only what the last strip wrote. One drawer (and
+    /// one pair of buffers) draws a sequence of different frames, of
+    /// different sizes, in every mode (immediate, set up once, tiles,
+    /// shaded, clipless), with the depth buffer cleared to another value
+    /// on the way: each frame equals the one-piece render into freshly
+    /// cleared buffers, every pixel pushed. (Clearing nothing, or only
+    /// the last strip's rows, fails it.)
+    fn strip_clears_case<D: DepthWord>(seed: u64, frames: &[(u32, u32, u8, usize)], rows: u32) {
+        let mut color = vec![Rgb565::BLACK; 64 * rows as usize];
+        let mut depth = vec![D::from_z32(0); 64 * rows as usize];
+        let bg = Rgb565::new(3, 9, 27);
+        let mut drawer = Some(StripDrawer::new(&mut color, &mut depth[..], bg));
+        for (k, &(w, h, mode, n)) in frames.iter().enumerate() {
+            // Few widths, so that frames often share one (the drawer
+            // starts over at a new width).
+            let w = [8, 17, 33, 64][w as usize % 4];
+            let seed = seed.wrapping_add(k as u64 * 0x9e37_79b9);
+            let mut c = Config::new(w, h);
+            c.cull = CullMode::None;
+            let greater = mode == 6;
+            if greater {
+                c.depth_func = crate::DepthFunc::Greater;
+            }
+            let fc = c;
+            let mode = if mode == 5 && !cfg!(feature = "clipless") {
+                0
+            } else {
+                mode
+            };
+            if mode == 5 {
+                c.mode = crate::RasterMode::Clipless;
+            }
+            if greater {
+                drawer = drawer.map(|d| d.with_clear_depth(0));
+            } else if k > 0 && frames[k - 1].2 == 6 {
+                drawer = drawer.map(|d| d.with_clear_depth(u32::MAX));
+            }
+            let Some(dr) = drawer.as_mut() else { return };
+            let flip = |p: [Vec4; 3]| match greater {
+                true => p.map(|q| Vec4::new(q.x, q.y, -q.z, q.w)),
+                false => p,
+            };
+            // The reference: one piece, fresh buffers.
+            let mut storage = vec![SetupTriangle::EMPTY; n];
+            let mut frame: Frame = Frame::new(fc, &mut storage).unwrap();
+            let mut expected = vec![bg; (w * h) as usize];
+            if mode != 5 {
+                random_scene(seed, n, |p, col, id| {
+                    frame.submit_clip_triangle(flip(p), col, id).unwrap()
+                });
+                let mut z = vec![D::from_z32(if greater { 0 } else { u32::MAX }); (w * h) as usize];
+                frame.render_rows(0, h, &mut expected, &mut z[..]).unwrap();
+            } else {
+                let mut z = vec![D::from_z32(u32::MAX); (w * h) as usize];
+                let mut one =
+                    StripRenderer::<Rgb565, [D]>::new(c, 0, h, &mut expected, &mut z[..]).unwrap();
+                random_scene(seed, n, |p, col, id| {
+                    one.submit_clip_triangle(p, col, id).unwrap()
+                });
+            }
+            let mut got = Capture {
+                width: w,
+                pixels: vec![None; (w * h) as usize],
+            };
+            match mode {
+                0 | 5 | 6 => {
+                    dr.draw(&mut got, c, |strip| {
+                        random_scene(seed, n, |p, col, id| {
+                            strip.submit_clip_triangle(flip(p), col, id).unwrap()
+                        })
+                    })
+                    .unwrap();
+                }
+                1 => {
+                    dr.draw_frame(&mut got, &frame).unwrap();
+                }
+                2 => {
+                    dr.draw_frame_shaded(&mut got, &frame, &crate::VertexColor)
+                        .unwrap();
+                }
+                _ => {
+                    let (tw, th) = (8 + (seed % 3) as u32 * 8, rows.min(8));
+                    let mut offsets = vec![0u32; frame.tiles(tw, th) + 1];
+                    let mut items = vec![0u32; frame.tile_bin_entries(tw, th)];
+                    let bins = frame.bin_tiles(tw, th, &mut offsets, &mut items).unwrap();
+                    dr.draw_frame_tiles(&mut got, &frame, &bins).unwrap();
+                }
+            }
+            let got: Vec<Rgb565> = got
+                .pixels
+                .iter()
+                .map(|p| p.expect("every pixel pushed"))
+                .collect();
+            assert!(
+                got == expected,
+                "frame {k} ({w}x{h}, mode {mode}, {n} triangles, {rows} rows)"
+            );
+        }
+    }
+
+    proptest::proptest! {
+        // Few cases under Miri, and no failure file (as in `depth.rs`).
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            cases: if cfg!(miri) { 2 } else { 256 },
+            failure_persistence: None,
+            ..proptest::prelude::ProptestConfig::default()
+        })]
+        #[test]
+        fn strip_clears_restore_the_background(
+            seed in proptest::prelude::any::<u64>(),
+            frames in proptest::collection::vec(
+                (0u32..4, 1u32..=40, 0u8..=6, 0usize..=12), 1..=6),
+            rows in 1u32..=16,
+            wide in proptest::prelude::any::<bool>(),
+        ) {
+            match wide {
+                false => strip_clears_case::<u16>(seed, &frames, rows),
+                true => strip_clears_case::<u32>(seed, &frames, rows),
+            }
+        }
     }
 }

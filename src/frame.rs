@@ -21,7 +21,7 @@ use crate::config::{check_rect, check_size, Config, Error, RasterMode};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
-use crate::raster::{draw, Strip};
+use crate::raster::{draw, Strip, Touched};
 use crate::setup::SetupTriangle;
 use crate::shade::{FragmentShader, VertexColor};
 use crate::stats::{RenderStats, Stats};
@@ -255,15 +255,17 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         let rect = bins.rect(tile);
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
         let tris = self.triangles();
-        Ok(self.draw_each(
-            rect,
-            color,
-            depth,
-            fragment,
-            bins.strip_items(tile)
-                .iter()
-                .filter_map(|&i| tris.get(i as usize)),
-        ))
+        Ok(self
+            .draw_each(
+                rect,
+                color,
+                depth,
+                fragment,
+                bins.strip_items(tile)
+                    .iter()
+                    .filter_map(|&i| tris.get(i as usize)),
+            )
+            .0)
     }
 
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which
@@ -297,6 +299,22 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
     ) -> Result<RenderStats, Error> {
+        Ok(self.render_rect_touched(rect, color, depth, fragment)?.0)
+    }
+
+    /// [`Frame::render_rect_shaded`], and the box of what it wrote (for
+    /// [`crate::StripDrawer`]'s clears).
+    pub(crate) fn render_rect_touched<
+        C: PixelFormat,
+        D: DepthBuffer + ?Sized,
+        F: FragmentShader<N>,
+    >(
+        &self,
+        rect: [u32; 4],
+        color: &mut [C],
+        depth: &mut D,
+        fragment: &F,
+    ) -> Result<(RenderStats, Touched), Error> {
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
         Ok(self.draw_each(rect, color, depth, fragment, self.triangles().iter()))
     }
@@ -309,7 +327,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
         tris: impl Iterator<Item = &'t SetupTriangle<N>>,
-    ) -> RenderStats {
+    ) -> (RenderStats, Touched) {
         let c = &self.stage.config;
         let mut strip = Strip {
             width: (x1 - x0) as usize,
@@ -321,6 +339,8 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             depth,
             depth_func: c.depth_func,
             depth_write: c.depth_write,
+            touched: Touched::NONE,
+            track: true,
         };
         let mut stats = RenderStats::default();
         for t in tris {
@@ -335,7 +355,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             }
             stats.pixels_written += draw::<S, N, C, D, F>(t, &mut strip, fragment) as u64;
         }
-        stats
+        (stats, strip.touched)
     }
 }
 

@@ -440,6 +440,61 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
     pub depth: &'b mut D,
     pub depth_func: DepthFunc,
     pub depth_write: bool,
+    /// The boxes of the triangles that wrote a pixel, so far, kept only
+    /// where `track` (for [`crate::StripDrawer`]; a renderer of the
+    /// caller's pays a test a triangle, not the box).
+    pub touched: Touched,
+    pub track: bool,
+}
+
+/// A box holding every pixel a render wrote: the union of the bounding
+/// boxes (frame pixels, inclusive) of the triangles that wrote at least
+/// one, not clipped to the window. What [`StripDrawer`] clears before
+/// the next strip instead of the whole buffer.
+///
+/// [`StripDrawer`]: crate::StripDrawer
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Touched {
+    pub min_x: u32,
+    pub max_x: u32,
+    pub min_y: u32,
+    pub max_y: u32,
+}
+
+impl Touched {
+    /// No pixel.
+    pub const NONE: Touched = Touched {
+        min_x: u32::MAX,
+        max_x: 0,
+        min_y: u32::MAX,
+        max_y: 0,
+    };
+
+    /// Adds the box `min_x..=max_x` by `min_y..=max_y`.
+    #[inline(always)]
+    pub fn add(&mut self, min_x: u32, max_x: u32, min_y: u32, max_y: u32) {
+        self.min_x = self.min_x.min(min_x);
+        self.max_x = self.max_x.max(max_x);
+        self.min_y = self.min_y.min(min_y);
+        self.max_y = self.max_y.max(max_y);
+    }
+
+    /// The part inside the window `[x0, x1, y0, y1]` (columns `x0..x1`,
+    /// rows `y0..y1`), as columns and rows relative to the window's
+    /// corner, `[x0, x1, r0, r1]` half open; all zero when empty.
+    pub fn within(self, [x0, x1, y0, y1]: [u32; 4]) -> [usize; 4] {
+        let (a, b) = (self.min_x.max(x0), self.max_x.saturating_add(1).min(x1));
+        let (c, d) = (self.min_y.max(y0), self.max_y.saturating_add(1).min(y1));
+        if a >= b || c >= d {
+            return [0; 4];
+        }
+        [
+            (a - x0) as usize,
+            (b - x0) as usize,
+            (c - y0) as usize,
+            (d - y0) as usize,
+        ]
+    }
 }
 
 /// Triangles whose bounding box is narrower than this many pixels are
@@ -766,12 +821,18 @@ pub(crate) fn draw<
     strip: &mut Strip<'_, C, D>,
     fragment: &F,
 ) -> u32 {
-    match (D::WIDE, fits_i32(t)) {
+    let written = match (D::WIDE, fits_i32(t)) {
         (true, true) => draw_in::<S, N, C, D, F, f64, i32>(t, strip, fragment),
         (true, false) => draw_in::<S, N, C, D, F, f64, i64>(t, strip, fragment),
         (false, true) => draw_in::<S, N, C, D, F, f32, i32>(t, strip, fragment),
         (false, false) => draw_in::<S, N, C, D, F, f32, i64>(t, strip, fragment),
+    };
+    if strip.track && written != 0 {
+        // Every pixel `draw_in` writes lies in the triangle's box.
+        let (x, y) = (t.min_x as u32, t.min_y as u32);
+        strip.touched.add(x, t.max_x as u32, y, t.max_y as u32);
     }
+    written
 }
 
 /// [`draw`] with depth interpolated in `R` and edge values in `T`.

@@ -21,7 +21,7 @@ use crate::config::{check_rect, check_size, Config, Error};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
-use crate::raster::{draw, Strip};
+use crate::raster::{draw, Strip, Touched};
 use crate::setup::SetupTriangle;
 use crate::shade::{FragmentShader, VertexColor};
 use crate::stats::{RenderStats, Stats};
@@ -224,6 +224,8 @@ where
                     depth,
                     depth_func: config.depth_func,
                     depth_write: config.depth_write,
+                    touched: Touched::NONE,
+                    track: false,
                 },
                 fragment,
                 render: RenderStats::default(),
@@ -245,6 +247,17 @@ where
     /// Pixels written so far.
     pub fn render_stats(&self) -> RenderStats {
         self.sink.render
+    }
+
+    /// Keeps the box of the pixels written from now on (for
+    /// [`crate::StripDrawer`]'s clears).
+    pub(crate) fn track_touched(&mut self) {
+        self.sink.strip.track = true;
+    }
+
+    /// The box of the pixels written since [`StripRenderer::track_touched`].
+    pub(crate) fn touched(&self) -> Touched {
+        self.sink.strip.touched
     }
 }
 

@@ -354,6 +354,9 @@ fn main() -> ! {
     };
     let checksum = display.checksum();
     let (statics, stack) = ram_use();
+    // What the strip clears restored (see the split below).
+    #[cfg(not(feature = "tiles"))]
+    let cleared_px = drawer.pixels_cleared();
 
     // Where the instructions went. Set-up-once mode measures them apart in
     // the frame itself: the vertex stage and setup (once per frame), the
@@ -362,18 +365,29 @@ fn main() -> ! {
     // strip: that is estimated as the scene submitted to a one-row strip
     // (which includes that one row's pixels), times the strips.
     let strips = HEIGHT.div_ceil(STRIP_ROWS as u32) as u64;
-    // Strip clears: the same drawer drawing an empty scene in immediate
-    // mode (each strip cleared, an empty renderer made for it, pushed),
-    // less its pushes. (Set up once, the frame makes no renderers: this
-    // overstates its clears by that, a few hundred instructions a strip.
-    // Measuring with `draw_frame` instead would give it a second call site
-    // and change how the frame itself compiles.)
+    // Strip clears. The drawer clears, before each strip, only what the
+    // strip before it wrote (`pixels_cleared` counts those pixels), so
+    // they are estimated: the same drawer draws an empty scene in
+    // immediate mode twice, first with its buffers taken as unknown (its
+    // first strip cleared whole, then nothing), then again (nothing
+    // cleared), each less its pushes. The difference is the cost of the
+    // pixels the first cleared; the frame's clears are its own pixels
+    // cleared at that rate. (The clears' cost a strip and a row is left
+    // in rasterization. Measuring with `draw_frame` instead would give it
+    // a second call site and change how the frame itself compiles.)
     let mut empty = HashDisplay::new(WIDTH, HEIGHT, display.clock);
     #[cfg(not(feature = "tiles"))]
     let clear_ticks = {
+        let mut drawer = drawer.with_clear_depth(clear_z32);
+        let (t, px) = (empty.clock.now(), drawer.pixels_cleared());
+        let _ = drawer.draw(&mut empty, config, |_| {});
+        let whole = (empty.clock.now() - t) - empty.ticks;
+        let whole_px = drawer.pixels_cleared() - px;
+        empty = HashDisplay::new(WIDTH, HEIGHT, empty.clock);
         let t = empty.clock.now();
         let _ = drawer.draw(&mut empty, config, |_| {});
-        (empty.clock.now() - t) - empty.ticks
+        let none = (empty.clock.now() - t) - empty.ticks;
+        (whole.saturating_sub(none) * cleared_px).div_ceil(whole_px.max(1))
     };
     // Tiles: an empty frame through the same tiles (each cleared, its
     // empty bin drawn, pushed), less its pushes.
