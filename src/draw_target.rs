@@ -203,34 +203,28 @@ pub trait StripDepth {
     }
 }
 
-/// The values of the rectangle `[x0, x1, r0, r1]` of a layout `width`
-/// values a row set to `v`, as far as `buf` reaches: one run where the
-/// rectangle spans whole rows, else a run a row.
+/// The runs of the rectangle `[x0, x1, r0, r1]` of a layout `width`
+/// values a row, as `(count, first, stride, len)`: one run where it spans
+/// whole rows, else one a row.
 #[inline]
-fn clear_rect<T: Copy>(buf: &mut [T], v: T, width: usize, [x0, x1, r0, r1]: [usize; 4]) {
-    if x0 == 0 && x1 == width {
-        let end = (r1 * width).min(buf.len());
-        if let Some(run) = buf.get_mut(r0 * width..end) {
-            fill8(run, v);
-        }
-        return;
+fn rect_runs(width: usize, [x0, x1, r0, r1]: [usize; 4]) -> (usize, usize, usize, usize) {
+    if width == 0 {
+        return (0, 0, 0, 0);
     }
-    for r in r0..r1 {
-        let end = (r * width + x1).min(buf.len());
-        if let Some(run) = buf.get_mut(r * width + x0..end) {
-            fill8(run, v);
-        }
+    match x0 == 0 && x1 == width {
+        true => (
+            1,
+            r0.saturating_mul(width),
+            0,
+            r1.saturating_sub(r0).saturating_mul(width),
+        ),
+        false => (
+            r1.saturating_sub(r0),
+            r0.saturating_mul(width).saturating_add(x0),
+            width,
+            x1.saturating_sub(x0),
+        ),
     }
-}
-
-/// `buf.fill(v)`, in blocks of eight (as `clear_both`).
-#[inline]
-fn fill8<T: Copy>(buf: &mut [T], v: T) {
-    let mut b8 = buf.chunks_exact_mut(8);
-    for b in &mut b8 {
-        b.fill(v);
-    }
-    b8.into_remainder().fill(v);
 }
 
 /// [`StripDepth::cleared_rect`] of both slice impls: the rectangle of
@@ -247,30 +241,25 @@ fn clear_rect_prefix<'a, W: DepthWord, P: Copy>(
         return None;
     }
     let z = W::from_z32(z32);
-    let [x0, x1, r0, r1] = rect;
-    if x0 == 0 && x1 == width {
-        if let (Some(d), Some(c)) = (depth.get_mut(..r1 * width), color.get_mut(..r1 * width)) {
-            let (d, c) = (&mut d[r0 * width..], &mut c[r0 * width..]);
-            clear_both(d, z, c, background);
-            return depth.get_mut(..len);
+    let (n, first, stride, run) = rect_runs(width, rect);
+    let end = depth.len().max(color.len());
+    for k in 0..n {
+        let a = first.saturating_add(k.saturating_mul(stride));
+        if a >= end {
+            break;
         }
-    } else {
-        let mut ok = true;
-        for r in r0..r1 {
-            let run = r * width + x0..r * width + x1;
-            match (depth.get_mut(run.clone()), color.get_mut(run)) {
-                (Some(d), Some(c)) => clear_both(d, z, c, background),
-                _ => ok = false,
+        let b = a.saturating_add(run);
+        match (depth.get_mut(a..b), color.get_mut(a..b)) {
+            (Some(d), Some(c)) => clear_both(d, z, c, background),
+            // Past either buffer (the drawer never asks for that): as far
+            // as each reaches.
+            _ => {
+                let (dl, cl) = (depth.len(), color.len());
+                depth[a.min(dl)..b.min(dl)].fill(z);
+                color[a.min(cl)..b.min(cl)].fill(background);
             }
         }
-        if ok {
-            return depth.get_mut(..len);
-        }
     }
-    // A rectangle past either buffer (the drawer never asks for one):
-    // as far as each reaches.
-    clear_rect(depth, z, width, rect);
-    clear_rect(color, background, width, rect);
     depth.get_mut(..len)
 }
 
@@ -313,34 +302,42 @@ fn clear_both<W: Copy, P: Copy>(depth: &mut [W], z: W, color: &mut [P], c: P) {
     c8.into_remainder().fill(c);
 }
 
+/// The three clears of both slice impls of [`StripDepth`] (a slice and
+/// an array), the same code.
+macro_rules! slice_clears {
+    () => {
+        fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
+            clear_prefix::<W, ()>(&mut self[..], len, z32, None)
+        }
+        fn cleared_with<P: Copy>(
+            &mut self,
+            len: usize,
+            z32: u32,
+            color: &mut [P],
+            background: P,
+        ) -> Option<&mut [W]> {
+            clear_prefix(&mut self[..], len, z32, Some((color, background)))
+        }
+        fn cleared_rect<P: Copy>(
+            &mut self,
+            len: usize,
+            z32: u32,
+            color: &mut [P],
+            background: P,
+            width: usize,
+            rect: [usize; 4],
+        ) -> Option<&mut [W]> {
+            clear_rect_prefix(&mut self[..], len, z32, (color, background), width, rect)
+        }
+    };
+}
+
 impl<W: DepthWord> StripDepth for &mut [W] {
     type Rows = [W];
     fn held(&self) -> Option<usize> {
         Some(self.len())
     }
-    fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
-        clear_prefix::<W, ()>(&mut self[..], len, z32, None)
-    }
-    fn cleared_with<P: Copy>(
-        &mut self,
-        len: usize,
-        z32: u32,
-        color: &mut [P],
-        background: P,
-    ) -> Option<&mut [W]> {
-        clear_prefix(&mut self[..], len, z32, Some((color, background)))
-    }
-    fn cleared_rect<P: Copy>(
-        &mut self,
-        len: usize,
-        z32: u32,
-        color: &mut [P],
-        background: P,
-        width: usize,
-        rect: [usize; 4],
-    ) -> Option<&mut [W]> {
-        clear_rect_prefix(&mut self[..], len, z32, (color, background), width, rect)
-    }
+    slice_clears!();
 }
 
 impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
@@ -348,29 +345,7 @@ impl<W: DepthWord, const N: usize> StripDepth for &mut [W; N] {
     fn held(&self) -> Option<usize> {
         Some(N)
     }
-    fn cleared(&mut self, len: usize, z32: u32) -> Option<&mut [W]> {
-        clear_prefix::<W, ()>(&mut self[..], len, z32, None)
-    }
-    fn cleared_with<P: Copy>(
-        &mut self,
-        len: usize,
-        z32: u32,
-        color: &mut [P],
-        background: P,
-    ) -> Option<&mut [W]> {
-        clear_prefix(&mut self[..], len, z32, Some((color, background)))
-    }
-    fn cleared_rect<P: Copy>(
-        &mut self,
-        len: usize,
-        z32: u32,
-        color: &mut [P],
-        background: P,
-        width: usize,
-        rect: [usize; 4],
-    ) -> Option<&mut [W]> {
-        clear_rect_prefix(&mut self[..], len, z32, (color, background), width, rect)
-    }
+    slice_clears!();
 }
 
 impl StripDepth for NoDepth {
@@ -409,16 +384,15 @@ impl StripDepth for NoDepth {
         rect: [usize; 4],
     ) -> Option<&mut NoDepth> {
         // Each run by `cleared_with`'s loop (a shared `fill` costs more).
-        let [x0, x1, r0, r1] = rect;
-        let runs = match x0 == 0 && x1 == width {
-            true => (0..1, r0 * width..r1 * width),
-            false => (r0..r1, x0..x1),
-        };
-        for r in runs.0 {
-            let (a, b) = (r * width + runs.1.start, r * width + runs.1.end);
-            if let Some(run) = color.get_mut(a..b.min(color.len())) {
-                self.cleared_with(0, 0, run, background);
+        let (n, first, stride, run) = rect_runs(width, rect);
+        let cl = color.len();
+        for k in 0..n {
+            let a = first.saturating_add(k.saturating_mul(stride));
+            if a >= cl {
+                break;
             }
+            let b = a.saturating_add(run);
+            self.cleared_with(0, 0, &mut color[a.min(cl)..b.min(cl)], background);
         }
         Some(self)
     }
@@ -1226,6 +1200,56 @@ mod tests {
             std::format!("{}", DrawError::<&str>::Target("x")),
             "draw target: x"
         );
+    }
+
+    /// `cleared_rect` with any rectangle (reversed, past the buffers,
+    /// near `usize::MAX`) clears what it reaches of it and nothing else,
+    /// and never panics; `None` (nothing cleared) if `len` is not held.
+    #[test]
+    fn cleared_rect_takes_any_rectangle() {
+        let big = usize::MAX;
+        for rect in [
+            [2, 5, 1, 3],
+            [0, 6, 1, 3],
+            [5, 2, 0, 3],
+            [0, 6, 3, 1],
+            [4, 9, 3, 9],
+            [0, 6, 2, big],
+            [big - 1, big, big - 2, big],
+            [0, big, 0, big],
+        ] {
+            // A layout zero wide has no rows: nothing is cleared.
+            let (mut d, mut c) = (vec![7u16; 4], vec![Rgb565::RED; 4]);
+            let mut held = &mut d[..];
+            assert!(held
+                .cleared_rect(4, 0, &mut c, Rgb565::BLUE, 0, rect)
+                .is_some());
+            assert_eq!((d, c), (vec![7u16; 4], vec![Rgb565::RED; 4]));
+
+            let (mut d, mut c) = (vec![7u16; 24], vec![Rgb565::RED; 20]);
+            let mut held = &mut d[..];
+            let rows = held.cleared_rect(24, u32::MAX, &mut c, Rgb565::BLUE, 6, rect);
+            assert_eq!(rows.map(|r| r.len()), Some(24));
+            let [x0, x1, r0, r1] = rect;
+            let inside = |i: usize| (r0..r1).contains(&(i / 6)) && (x0..x1).contains(&(i % 6));
+            for (i, &v) in d.iter().enumerate() {
+                assert_eq!(v == u16::MAX, inside(i), "depth {i} of {rect:?}");
+            }
+            for (i, &v) in c.iter().enumerate() {
+                assert_eq!(v == Rgb565::BLUE, inside(i), "colour {i} of {rect:?}");
+            }
+            let mut c2 = c.clone();
+            let mut none = NoDepth;
+            none.cleared_rect(0, 0, &mut c2, Rgb565::GREEN, 6, rect);
+            for (i, &v) in c2.iter().enumerate() {
+                assert_eq!(v == Rgb565::GREEN, inside(i), "no depth {i} of {rect:?}");
+            }
+        }
+        let (mut d, mut c) = (vec![7u16; 4], vec![Rgb565::RED; 4]);
+        assert!((&mut d[..])
+            .cleared_rect(5, 0, &mut c, Rgb565::BLUE, 2, [0, 2, 0, 2])
+            .is_none());
+        assert_eq!((d, c), (vec![7u16; 4], vec![Rgb565::RED; 4]));
     }
 
     /// What a sequence of draws pushed: the frame's pixels (and how many
