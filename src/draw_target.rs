@@ -494,8 +494,9 @@ impl<'b, P: PixelFormat, D: StripDepth> StripDrawer<'b, P, D> {
     /// is cleared where the strip before it wrote, not whole: the buffers
     /// are the drawer's alone, so everything else still holds the
     /// background and the far depth. The first strip after
-    /// [`StripDrawer::new`], a change of frame width or
-    /// [`StripDrawer::draw_frame_tiles`] clears every row the buffers hold.
+    /// [`StripDrawer::new`], [`StripDrawer::with_clear_depth`], a change of
+    /// frame width or [`StripDrawer::draw_frame_tiles`] clears every row
+    /// the buffers hold.
     pub fn pixels_cleared(&self) -> u64 {
         self.cleared
     }

@@ -264,6 +264,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
                 bins.strip_items(tile)
                     .iter()
                     .filter_map(|&i| tris.get(i as usize)),
+                false,
             )
             .0)
     }
@@ -299,7 +300,9 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
     ) -> Result<RenderStats, Error> {
-        Ok(self.render_rect_touched(rect, color, depth, fragment)?.0)
+        check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
+        let tris = self.triangles().iter();
+        Ok(self.draw_each(rect, color, depth, fragment, tris, false).0)
     }
 
     /// [`Frame::render_rect_shaded`], and the box of what it wrote (for
@@ -316,10 +319,12 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         fragment: &F,
     ) -> Result<(RenderStats, Touched), Error> {
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
-        Ok(self.draw_each(rect, color, depth, fragment, self.triangles().iter()))
+        let tris = self.triangles().iter();
+        Ok(self.draw_each(rect, color, depth, fragment, tris, true))
     }
 
-    /// Draws `tris` into a checked rectangle.
+    /// Draws `tris` into a checked rectangle, keeping the box of what it
+    /// wrote where `track` (only the drawer reads it).
     fn draw_each<'t, C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
         [x0, x1, y0, y1]: [u32; 4],
@@ -327,6 +332,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
         tris: impl Iterator<Item = &'t SetupTriangle<N>>,
+        track: bool,
     ) -> (RenderStats, Touched) {
         let c = &self.stage.config;
         let mut strip = Strip {
@@ -340,7 +346,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             depth_func: c.depth_func,
             depth_write: c.depth_write,
             touched: Touched::NONE,
-            track: true,
+            track,
         };
         let mut stats = RenderStats::default();
         for t in tris {

@@ -441,8 +441,8 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
     pub depth_func: DepthFunc,
     pub depth_write: bool,
     /// The boxes of the triangles that wrote a pixel, so far, kept only
-    /// where `track` (for [`crate::StripDrawer`]; a renderer of the
-    /// caller's pays a test a triangle, not the box).
+    /// where `track` (for [`crate::StripDrawer`]; the caller's own
+    /// renders pay a test a triangle, not the box).
     pub touched: Touched,
     pub track: bool,
 }
