@@ -259,7 +259,7 @@ pub struct RenderArgs {
     pub cull: CullArg,
 
     /// Cull back-facing clusters before transform (meshoptimizer meshlets
-    /// of 16 triangles; see docs/culling.md): culling volumes or normal
+    /// of 12 triangles; see docs/culling.md): culling volumes or normal
     /// cones, at the leaves or down the tree.
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
@@ -536,7 +536,7 @@ pub struct BenchArgs {
     pub cull: CullArg,
 
     /// Cull back-facing clusters before transform (meshoptimizer meshlets
-    /// of 16 triangles; see docs/culling.md): culling volumes or normal
+    /// of 12 triangles; see docs/culling.md): culling volumes or normal
     /// cones, at the leaves or down the tree.
     #[arg(long, value_enum, value_name = "TEST")]
     pub cull_clusters: Option<ClusterCullArg>,
@@ -896,7 +896,7 @@ pub struct CullArgs {
     pub max_vertices: usize,
 
     /// Triangles per cluster, at most (a multiple of 4).
-    #[arg(long, value_name = "N", default_value = "16")]
+    #[arg(long, value_name = "N", default_value = "12")]
     pub max_triangles: usize,
 
     /// meshoptimizer's cone weight (0..1).

@@ -55,7 +55,7 @@ impl Default for ClusterOptions {
     fn default() -> Self {
         ClusterOptions {
             max_vertices: 64,
-            max_triangles: 16,
+            max_triangles: 12,
             cone_weight: 1.0,
             t_over_r: 1.0,
             shared: true,

@@ -163,7 +163,7 @@ fn cluster_eye(mvp: &Mat4, config: &Config) -> Option<Eye> {
 }
 
 /// What the frame's cluster test decided, once for all strips: a bit per
-/// cluster, set where it is drawn (46 bytes for Spot's 366 clusters;
+/// cluster, set where it is drawn (64 bytes for Spot's 488 clusters;
 /// nothing without `clusters`).
 #[cfg(feature = "clusters")]
 type Drawn = [u32; clustered::CLUSTER_COUNT.div_ceil(32)];
