@@ -208,10 +208,23 @@ pub enum Error {
     /// ranges or targets run past its cells or portals, with a bad box, or
     /// a walk given a bad start cell or rectangle slice.
     InvalidPortals(crate::portal::PortalFault),
+    /// A [`LazyClear`](crate::LazyClear) given fewer hull values than its
+    /// rectangle has rows, or a rectangle wider than `2^16` columns.
+    HullSize {
+        /// Rows of the rectangle.
+        expected: usize,
+        /// Hull values given.
+        actual: usize,
+    },
+    /// A render given a [`LazyClear`](crate::LazyClear) made for another
+    /// rectangle.
+    LazyClearRect,
     /// [`RasterMode::Clipless`] given to a [`Frame`](crate::Frame), whose
     /// setup storage holds snapped triangles only (draw clipless triangles
     /// with a [`StripRenderer`](crate::StripRenderer)), or to any receiver
-    /// of a crate built without its `clipless` feature.
+    /// of a crate built without its `clipless` feature; a deferred clear
+    /// ([`LazyClear`](crate::LazyClear)) in a crate built without its
+    /// `lazy-clear` feature.
     ModeUnsupported,
 }
 
@@ -302,6 +315,13 @@ impl core::fmt::Display for Error {
             Error::HiZSize { expected, actual } => {
                 write!(f, "{actual} hi-z tiles given, the strip needs {expected}")
             }
+            Error::HullSize { expected, actual } => write!(
+                f,
+                "{actual} hull values given for a deferred clear of {expected} rows"
+            ),
+            Error::LazyClearRect => {
+                write!(f, "the deferred clear was made for another rectangle")
+            }
             Error::InvalidNormalClasses(fault) => match fault {
                 crate::normal_mask::ClassFault::Partitions => {
                     write!(f, "normal classes need 1 to 16 partitions a side")
@@ -318,7 +338,7 @@ impl core::fmt::Display for Error {
             },
             Error::ModeUnsupported => write!(
                 f,
-                "the clipless mode needs a StripRenderer (a Frame stores snapped triangles only) and the crate's clipless feature"
+                "the clipless mode needs a StripRenderer (a Frame stores snapped triangles only) and the crate's clipless feature; a deferred clear needs its lazy-clear feature"
             ),
         }
     }

@@ -189,6 +189,43 @@ pub trait DepthBuffer {
         };
         self.flat_span(color, start, len, z0 as i64, dz, func, true, px)
     }
+
+    /// Sets values `start..start + len` (those held) to the depth `z32`
+    /// (`Z32`), as a clear would: a deferred clear's
+    /// ([`LazyClear`](crate::LazyClear)) fill. The default stores each
+    /// through [`test_and_set`](DepthBuffer::test_and_set) under
+    /// [`DepthFunc::Always`].
+    #[doc(hidden)]
+    fn fill_z32(&mut self, start: usize, len: usize, z32: u32) {
+        let key = Self::key_of((z32 as i64) << Self::FRAC);
+        for index in start..start.saturating_add(len) {
+            self.test_and_set(index, key, DepthFunc::Always, true);
+        }
+    }
+
+    /// [`flat_span`](DepthBuffer::flat_span) under `Less`, with writes,
+    /// over pixels whose values do not matter because they are taken to
+    /// hold the clear depth `clear_z32` (a deferred clear's columns no
+    /// draw has reached): where every depth of the span is in range and
+    /// nearer than that, every pixel would pass, and the span is written
+    /// without reading the buffer (`Some(pixels written)`); otherwise
+    /// nothing is written (`None`). The default writes nothing.
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn untested_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        clear_z32: u32,
+        px: C,
+    ) -> Option<u32> {
+        let _ = (color, start, len, z0, dz, clear_z32, px);
+        None
+    }
 }
 
 /// The pixel-by-pixel span loop behind [`DepthBuffer::flat_span`].
@@ -281,6 +318,41 @@ fn span_z32<W: DepthWord, C: Copy, const CMP: u8>(
     px: C,
 ) -> u32 {
     z32_loop::<W, C, CMP>(c, d, z0, dz, px)
+}
+
+/// [`span_z32_untested`] for `Z32.16` words (`u32` buffers): `z` in a
+/// `u64`, each word [`DepthWord::from_fixed_in_range`].
+#[inline(never)]
+fn span_untested<W: DepthWord, C: Copy>(c: &mut [C], d: &mut [W], z0: u64, dz: u64, px: C) -> u32 {
+    let n = c.len().min(d.len());
+    let mut z = z0;
+    for (cp, dp) in c[..n].iter_mut().zip(d[..n].iter_mut()) {
+        *dp = W::from_fixed_in_range(z);
+        *cp = px;
+        z = z.wrapping_add(dz);
+    }
+    n as u32
+}
+
+/// The `Z32.0` span of [`DepthBuffer::untested_span`], where
+/// every pixel passes: each depth word and colour written without reading
+/// the buffer (the same values [`span_z32`] writes there).
+#[inline(never)]
+fn span_z32_untested<W: DepthWord, C: Copy>(
+    c: &mut [C],
+    d: &mut [W],
+    z0: u32,
+    dz: u32,
+    px: C,
+) -> u32 {
+    let n = c.len().min(d.len());
+    let mut z = z0;
+    for (cp, dp) in c[..n].iter_mut().zip(d[..n].iter_mut()) {
+        *dp = W::from_fixed_in_range(z as u64);
+        *cp = px;
+        z = z.wrapping_add(dz);
+    }
+    n as u32
 }
 
 /// The `Z32.0` span loop itself, shared by [`span_unclamped`] and
@@ -750,6 +822,45 @@ impl<W: DepthWord> DepthBuffer for [W] {
         }
     }
 
+    #[inline]
+    fn fill_z32(&mut self, start: usize, len: usize, z32: u32) {
+        let end = start.saturating_add(len).min(self.len());
+        if let Some(d) = self.get_mut(start..end) {
+            d.fill(W::from_z32(z32));
+        }
+    }
+
+    #[inline(always)]
+    fn untested_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        clear_z32: u32,
+        px: C,
+    ) -> Option<u32> {
+        if W::FINE || !in_range_throughout(z0, dz, len, W::FRAC) {
+            return None;
+        }
+        // In range at both ends and linear in between: the farthest depth
+        // is at one end, and no value is clamped.
+        let last = z0 + dz * (len as i64 - 1);
+        let far = W::key_in_range(z0.max(last) as u64);
+        if !passes::<{ cmp::LESS }, _>(far, W::from_z32(clear_z32).key()) {
+            return None;
+        }
+        let end = start.saturating_add(len);
+        let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end)) else {
+            return None;
+        };
+        Some(match W::FRAC {
+            0 => span_z32_untested(c, d, z0 as u32, dz as u32, px),
+            _ => span_untested(c, d, z0 as u64, dz as u64, px),
+        })
+    }
+
     fn depth_len(&self) -> Option<usize> {
         Some(self.len())
     }
@@ -812,6 +923,25 @@ impl<W: DepthWord, const N: usize> DepthBuffer for [W; N] {
         self[..].flat_span_in_range(color, start, len, z0, dz, cmp, px)
     }
 
+    #[inline]
+    fn fill_z32(&mut self, start: usize, len: usize, z32: u32) {
+        self[..].fill_z32(start, len, z32)
+    }
+
+    #[inline(always)]
+    fn untested_span<C: Copy>(
+        &mut self,
+        color: &mut [C],
+        start: usize,
+        len: usize,
+        z0: i64,
+        dz: i64,
+        clear_z32: u32,
+        px: C,
+    ) -> Option<u32> {
+        self[..].untested_span(color, start, len, z0, dz, clear_z32, px)
+    }
+
     fn depth_len(&self) -> Option<usize> {
         Some(N)
     }
@@ -866,6 +996,9 @@ impl DepthBuffer for NoDepth {
     fn test_and_set(&mut self, _: usize, _: u32, _: DepthFunc, _: bool) -> bool {
         true
     }
+
+    #[inline]
+    fn fill_z32(&mut self, _: usize, _: usize, _: u32) {}
 }
 
 #[cfg(test)]

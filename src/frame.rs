@@ -21,10 +21,120 @@ use crate::config::{check_rect, check_size, Config, Error, RasterMode};
 use crate::depth::DepthBuffer;
 use crate::fixed::check_subpixel_bits;
 use crate::pipeline::{__private::Sink, impl_submit, Stage};
-use crate::raster::{draw, Strip, Touched};
+use crate::raster::{draw, Strip, Touched, HULL_EMPTY};
 use crate::setup::SetupTriangle;
 use crate::shade::{FragmentShader, VertexColor};
 use crate::stats::{RenderStats, Stats};
+
+/// A deferred clear of one rectangle (a strip or a tile): instead of
+/// clearing the buffers and then drawing, [`Frame::render_tile_lazy`]
+/// draws into buffers that may hold anything, and [`LazyClear::finish`]
+/// then clears what no triangle reached. The pixels are those of a clear
+/// followed by the same draws ([`Frame::render_tile`]), for any depth
+/// test. Where a flat triangle of a `u16` buffer under
+/// [`DepthFunc::Less`](crate::DepthFunc::Less) reaches columns nothing
+/// has reached yet, nearer than the clear depth throughout, its spans are
+/// written without reading the buffers: a full-screen triangle costs one
+/// write of each pixel, not a clear, a read and a write.
+///
+/// The caller's `hull` holds one `u32` per row of the rectangle: the
+/// columns of that row that hold the clear or a draw.
+#[derive(Debug)]
+pub struct LazyClear<'h, C> {
+    hull: &'h mut [u32],
+    rect: [u32; 4],
+    color: C,
+    z32: u32,
+}
+
+impl<'h, C: PixelFormat> LazyClear<'h, C> {
+    /// A deferred clear of the rectangle `[x0, x1, y0, y1]` (columns
+    /// `x0..x1`, rows `y0..y1`) to the colour `color` and the depth `z32`
+    /// (`Z32`: `u32::MAX` for the far plane, as
+    /// [`DepthWord::FAR`](crate::DepthWord::FAR) holds it), with `hull`
+    /// holding at least one value per row ([`Error::HullSize`] otherwise).
+    pub fn new(hull: &'h mut [u32], rect: [u32; 4], color: C, z32: u32) -> Result<Self, Error> {
+        let rows = rect[3].saturating_sub(rect[2]) as usize;
+        let width = rect[1].saturating_sub(rect[0]);
+        if hull.len() < rows || width > 1 << 16 {
+            return Err(Error::HullSize {
+                expected: rows,
+                actual: hull.len(),
+            });
+        }
+        hull.fill(HULL_EMPTY);
+        Ok(LazyClear {
+            hull,
+            rect,
+            color,
+            z32,
+        })
+    }
+
+    /// The rectangle it clears.
+    pub fn rect(&self) -> [u32; 4] {
+        self.rect
+    }
+
+    /// Clears every pixel of the rectangle that no render reached, in
+    /// buffers holding exactly the rectangle (row `y0` first); returns the
+    /// pixels cleared. A buffer shorter than the rectangle is
+    /// [`Error::ColorBufferSize`] or [`Error::DepthBufferSize`], with
+    /// nothing cleared.
+    pub fn finish<D: DepthBuffer + ?Sized>(
+        self,
+        color: &mut [C],
+        depth: &mut D,
+    ) -> Result<u64, Error> {
+        let [x0, x1, y0, y1] = self.rect;
+        let width = x1.saturating_sub(x0) as usize;
+        let rows = y1.saturating_sub(y0) as usize;
+        let len = width * rows;
+        if color.len() < len {
+            return Err(Error::ColorBufferSize {
+                expected: len,
+                actual: color.len(),
+            });
+        }
+        if let Some(actual) = depth.depth_len() {
+            if actual < len {
+                return Err(Error::DepthBufferSize {
+                    expected: len,
+                    actual,
+                });
+            }
+        }
+        let mut cleared = 0u64;
+        let mut run = |start: usize, n: usize| {
+            if let Some(c) = color.get_mut(start..start + n) {
+                c.fill(self.color);
+            }
+            depth.fill_z32(start, n, self.z32);
+            cleared += n as u64;
+        };
+        for (r, &h) in self.hull.iter().take(rows).enumerate() {
+            let (lo, hi) = ((h & 0xFFFF) as usize, (h >> 16) as usize);
+            let row = r * width;
+            if lo > hi {
+                run(row, width);
+            } else {
+                run(row, lo.min(width));
+                run(row + hi + 1, width.saturating_sub(hi + 1));
+            }
+        }
+        Ok(cleared)
+    }
+}
+
+/// What a render keeps beside its pixels: nothing, the box of what it
+/// wrote (for [`crate::StripDrawer`]'s clears), or a deferred clear's
+/// hull.
+#[cfg_attr(not(feature = "lazy-clear"), allow(dead_code))]
+enum Keep<'a, 'h, C> {
+    Pixels,
+    Touched,
+    Lazy(&'a mut LazyClear<'h, C>),
+}
 
 /// The caller's setup storage and how much of it is used.
 #[derive(Debug)]
@@ -264,7 +374,53 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
                 bins.strip_items(tile)
                     .iter()
                     .filter_map(|&i| tris.get(i as usize)),
-                false,
+                Keep::Pixels,
+            )
+            .0)
+    }
+
+    /// [`Frame::render_tile_shaded`] under a deferred clear (see
+    /// [`LazyClear`]): the buffers may hold anything where `lazy` has not
+    /// reached, and [`LazyClear::finish`] clears that after the last
+    /// render (several frames may be drawn in turn, as layers).
+    /// [`Error::LazyClearRect`] if `lazy` was made for another rectangle
+    /// than the tile's; [`Error::ModeUnsupported`] from a crate built
+    /// without its `lazy-clear` feature (a default one).
+    pub fn render_tile_lazy_shaded<
+        C: PixelFormat,
+        D: DepthBuffer + ?Sized,
+        F: FragmentShader<N>,
+    >(
+        &self,
+        bins: &Bins<'_>,
+        tile: u32,
+        color: &mut [C],
+        depth: &mut D,
+        fragment: &F,
+        lazy: &mut LazyClear<'_, C>,
+    ) -> Result<RenderStats, Error> {
+        if !cfg!(feature = "lazy-clear") {
+            return Err(Error::ModeUnsupported);
+        }
+        if !bins.belong_to(&self.stage.config, self.store.len) {
+            return Err(Error::BinsMismatch);
+        }
+        let rect = bins.rect(tile);
+        check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
+        if lazy.rect != rect {
+            return Err(Error::LazyClearRect);
+        }
+        let tris = self.triangles();
+        Ok(self
+            .draw_each(
+                rect,
+                color,
+                depth,
+                fragment,
+                bins.strip_items(tile)
+                    .iter()
+                    .filter_map(|&i| tris.get(i as usize)),
+                Keep::Lazy(lazy),
             )
             .0)
     }
@@ -302,7 +458,9 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     ) -> Result<RenderStats, Error> {
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
         let tris = self.triangles().iter();
-        Ok(self.draw_each(rect, color, depth, fragment, tris, false).0)
+        Ok(self
+            .draw_each(rect, color, depth, fragment, tris, Keep::Pixels)
+            .0)
     }
 
     /// [`Frame::render_rect_shaded`], and the box of what it wrote (for
@@ -320,11 +478,11 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     ) -> Result<(RenderStats, Touched), Error> {
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
         let tris = self.triangles().iter();
-        Ok(self.draw_each(rect, color, depth, fragment, tris, true))
+        Ok(self.draw_each(rect, color, depth, fragment, tris, Keep::Touched))
     }
 
-    /// Draws `tris` into a checked rectangle, keeping the box of what it
-    /// wrote where `track` (only the drawer reads it).
+    /// Draws `tris` into a checked rectangle, keeping what `keep` says
+    /// (the box of what it wrote only for the drawer).
     fn draw_each<'t, C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
         &self,
         [x0, x1, y0, y1]: [u32; 4],
@@ -332,7 +490,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
         tris: impl Iterator<Item = &'t SetupTriangle<N>>,
-        track: bool,
+        keep: Keep<'_, '_, C>,
     ) -> (RenderStats, Touched) {
         let c = &self.stage.config;
         let mut strip = Strip {
@@ -346,7 +504,16 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             depth_func: c.depth_func,
             depth_write: c.depth_write,
             touched: Touched::NONE,
-            track,
+            track: matches!(keep, Keep::Touched),
+            #[cfg(feature = "lazy-clear")]
+            lazy: match keep {
+                Keep::Lazy(l) => Some(crate::raster::lazy::Lazy {
+                    hull: &mut *l.hull,
+                    color: l.color,
+                    z32: l.z32,
+                }),
+                _ => None,
+            },
         };
         let mut stats = RenderStats::default();
         for t in tris {
@@ -396,6 +563,19 @@ impl<const S: u32> Frame<'_, S, 3> {
         depth: &mut D,
     ) -> Result<RenderStats, Error> {
         self.render_tile_shaded(bins, tile, color, depth, &VertexColor)
+    }
+
+    /// [`Frame::render_tile`] under a deferred clear: see
+    /// [`Frame::render_tile_lazy_shaded`] and [`LazyClear`].
+    pub fn render_tile_lazy<C: PixelFormat, D: DepthBuffer + ?Sized>(
+        &self,
+        bins: &Bins<'_>,
+        tile: u32,
+        color: &mut [C],
+        depth: &mut D,
+        lazy: &mut LazyClear<'_, C>,
+    ) -> Result<RenderStats, Error> {
+        self.render_tile_lazy_shaded(bins, tile, color, depth, &VertexColor, lazy)
     }
 
     /// Renders the rectangle `[x0, x1, y0, y1]` into buffers that hold

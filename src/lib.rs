@@ -112,7 +112,7 @@ pub use cull::{Cluster, ClusterCull, ClusterNode, ClusterSet, ClusterTest, Detai
 pub use depth::{DepthBuffer, DepthF32, DepthFunc, DepthWord, NoDepth};
 pub use draw_target::{DrawError, StripDepth, StripDrawer, StripSink};
 pub use fixed::{MAX_DIMENSION, SUBPIXEL_BITS};
-pub use frame::Frame;
+pub use frame::{Frame, LazyClear};
 pub use math::{Mat4, Vec3, Vec4};
 pub use mesh::{BoundingSphere, Mesh, MeshColors, ProcessedVertex};
 pub use normal_mask::{BackMask, NormalClasses};

@@ -62,11 +62,27 @@
 //! division per pixel, then the fragment shader
 //! ([`FragmentShader`]) makes the colour. A triangle whose vertices carry
 //! equal varyings is shaded once per strip.
+//!
+//! A deferred clear ([`crate::LazyClear`], `Strip::lazy`) draws into
+//! buffers that hold anything: per row it keeps the columns `[lo, hi]`
+//! that hold the clear or a draw (the hull), and outside them nothing is
+//! read. A triangle of the `u16` `Less` flat path extends the hull span by
+//! span: a span beyond the hull whose depth is nearer than the clear
+//! everywhere is written without reading the buffers (every pixel would
+//! pass against the clear), the gap up to the hull cleared; any other
+//! span has its columns outside the hull cleared first and is then
+//! drawn as usual. Every other triangle first extends the hull over its
+//! box on each of its rows, clearing what that adds. What no row's hull
+//! holds at the end is cleared by `LazyClear::finish`: the same pixels as
+//! a clear before the draws.
 
 use crate::color::PixelFormat;
 use crate::depth::{cmp, DepthBuffer, DepthFunc};
 use crate::setup::SetupTriangle;
 use crate::shade::FragmentShader;
+
+#[cfg(feature = "lazy-clear")]
+pub(crate) mod lazy;
 
 /// The integer type edge functions are evaluated in: `i64` always works
 /// (`|E| < 2^59`); `i32` is exact for triangles whose vertices span at most
@@ -445,7 +461,13 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
     /// renders pay a test a triangle, not the box).
     pub touched: Touched,
     pub track: bool,
+    /// A deferred clear: the buffers hold anything outside the hull.
+    #[cfg(feature = "lazy-clear")]
+    pub lazy: Option<lazy::Lazy<'b, C>>,
 }
+
+/// A hull row holding no column.
+pub(crate) const HULL_EMPTY: u32 = 0xFFFF;
 
 /// A box holding every pixel a render wrote: the union of the bounding
 /// boxes (frame pixels, inclusive) of the triangles that wrote at least
@@ -862,6 +884,10 @@ fn draw_in<
         C::from_fragment(fragment.shade_flat(&t.var_w[0], t.flat, t.id), t.id)
     };
     let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
+    #[cfg(feature = "lazy-clear")]
+    if let Some(written) = lazy::enter::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat) {
+        return written;
+    }
     if EARLY_FLAT && !smooth && !crosses && t.max_x - t.min_x >= SMALL_WIDTH {
         // Flat spans, the most common case: their loop sets up its own
         // edges and depth plane, so none of it is handed over.

@@ -226,6 +226,8 @@ where
                     depth_write: config.depth_write,
                     touched: Touched::NONE,
                     track: false,
+                    #[cfg(feature = "lazy-clear")]
+                    lazy: None,
                 },
                 fragment,
                 render: RenderStats::default(),

@@ -65,9 +65,9 @@ use microraster::math::Libm;
 use microraster::math::{FloatFns, Micromath};
 use microraster::prelude::{DepthWord, PixelFormat, Submit};
 use microraster::{
-    BoundingSphere, ClipVertex, Config, CullMode, DepthFunc, Error, Frame, FrontFace, Mat4, Mesh,
-    MeshColors, NoDepth, ProcessedVertex, SetupTriangle, Stats, StripRenderer, TriangleId, Vec3,
-    Vec4,
+    BoundingSphere, ClipVertex, Config, CullMode, DepthFunc, Error, Frame, FrontFace, LazyClear,
+    Mat4, Mesh, MeshColors, NoDepth, ProcessedVertex, SetupTriangle, Stats, StripRenderer,
+    TriangleId, Vec3, Vec4,
 };
 
 /// At most this many pixels are rendered per buffer, to keep an execution
@@ -1392,6 +1392,46 @@ fn check_frame_typed<const S: u32, C: PixelWord, T: DepthGuard>(
             );
         }
     }
+    // A deferred clear of each strip, into buffers holding garbage (the
+    // guards' value), gives the cleared strip; a hull one short is an
+    // error that writes nothing.
+    for s in y0 / r..=(y1 - 1) / r {
+        let (a, b) = bins.rows(s);
+        let len = (b - a) as usize * w;
+        if len > PIXEL_BUDGET {
+            continue;
+        }
+        let rect = bins.rect(s);
+        let rows = (b - a) as usize;
+        let mut c = Guarded::new(len, C::GUARD, C::GUARD);
+        let mut d = Guarded::new(len, T::GUARD, T::GUARD);
+        let mut hull = vec![SENT; rows + input.past as usize % 3];
+        let short = LazyClear::new(&mut hull[..rows - 1], rect, C::CLEAR, T::FAR.to_z32());
+        assert!(matches!(short, Err(Error::HullSize { .. })), "{short:?}");
+        let mut lazy =
+            LazyClear::new(&mut hull, rect, C::CLEAR, T::FAR.to_z32()).expect("hull fits");
+        let res = if use_depth {
+            frame.render_tile_lazy(&bins, s, c.inner(), d.inner(), &mut lazy)
+        } else {
+            frame.render_tile_lazy(&bins, s, c.inner(), &mut NoDepth, &mut lazy)
+        };
+        res.unwrap_or_else(|e| panic!("render_tile_lazy {s}: {e:?}"));
+        let done = if use_depth {
+            lazy.finish(c.inner(), d.inner())
+        } else {
+            lazy.finish(c.inner(), &mut NoDepth)
+        };
+        assert!(done.is_ok_and(|n| n <= len as u64), "{done:?}");
+        c.check_guards();
+        d.check_guards();
+        let (rc, rd) = render::<S, C, T>(frame, a, b, use_depth);
+        assert!(c.get() == &rc[..], "deferred strip {s} colour differs");
+        if use_depth {
+            assert!(d.get() == &rd[..], "deferred strip {s} depth differs");
+        }
+        debug(|| format!("arm: deferred clear of strip {s}"));
+    }
+
     // Another frame's bins: a mismatch unless they look the same.
     other_frame_bins::<S, C>(input, frame, r);
 
