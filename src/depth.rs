@@ -320,35 +320,15 @@ fn span_z32<W: DepthWord, C: Copy, const CMP: u8>(
     z32_loop::<W, C, CMP>(c, d, z0, dz, px)
 }
 
-/// [`span_z32_untested`] for `Z32.16` words (`u32` buffers): `z` in a
-/// `u64`, each word [`DepthWord::from_fixed_in_range`].
+/// The span of [`DepthBuffer::untested_span`], where every pixel passes:
+/// each depth word ([`DepthWord::from_fixed_in_range`] of `z` stepped in
+/// a `u64`) and colour written without reading the buffer.
 #[inline(never)]
 fn span_untested<W: DepthWord, C: Copy>(c: &mut [C], d: &mut [W], z0: u64, dz: u64, px: C) -> u32 {
     let n = c.len().min(d.len());
     let mut z = z0;
     for (cp, dp) in c[..n].iter_mut().zip(d[..n].iter_mut()) {
         *dp = W::from_fixed_in_range(z);
-        *cp = px;
-        z = z.wrapping_add(dz);
-    }
-    n as u32
-}
-
-/// The `Z32.0` span of [`DepthBuffer::untested_span`], where
-/// every pixel passes: each depth word and colour written without reading
-/// the buffer (the same values [`span_z32`] writes there).
-#[inline(never)]
-fn span_z32_untested<W: DepthWord, C: Copy>(
-    c: &mut [C],
-    d: &mut [W],
-    z0: u32,
-    dz: u32,
-    px: C,
-) -> u32 {
-    let n = c.len().min(d.len());
-    let mut z = z0;
-    for (cp, dp) in c[..n].iter_mut().zip(d[..n].iter_mut()) {
-        *dp = W::from_fixed_in_range(z as u64);
         *cp = px;
         z = z.wrapping_add(dz);
     }
@@ -855,10 +835,9 @@ impl<W: DepthWord> DepthBuffer for [W] {
         let (Some(c), Some(d)) = (color.get_mut(start..end), self.get_mut(start..end)) else {
             return None;
         };
-        Some(match W::FRAC {
-            0 => span_z32_untested(c, d, z0 as u32, dz as u32, px),
-            _ => span_untested(c, d, z0 as u64, dz as u64, px),
-        })
+        // Wrapping `u64` sums of the start and step are the exact depths,
+        // all in range (as `span_unclamped` steps them).
+        Some(span_untested(c, d, z0 as u64, dz as u64, px))
     }
 
     fn depth_len(&self) -> Option<usize> {

@@ -359,24 +359,33 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         depth: &mut D,
         fragment: &F,
     ) -> Result<RenderStats, Error> {
+        self.draw_tile(bins, tile, color, depth, fragment, Keep::Pixels)
+    }
+
+    /// Draws tile `tile` of `bins` after checking the bins and the
+    /// buffers (and a deferred clear's rectangle), keeping what `keep`
+    /// says.
+    fn draw_tile<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
+        &self,
+        bins: &Bins<'_>,
+        tile: u32,
+        color: &mut [C],
+        depth: &mut D,
+        fragment: &F,
+        keep: Keep<'_, '_, C>,
+    ) -> Result<RenderStats, Error> {
         if !bins.belong_to(&self.stage.config, self.store.len) {
             return Err(Error::BinsMismatch);
         }
         let rect = bins.rect(tile);
         check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
+        if matches!(&keep, Keep::Lazy(lazy) if lazy.rect != rect) {
+            return Err(Error::LazyClearRect);
+        }
         let tris = self.triangles();
-        Ok(self
-            .draw_each(
-                rect,
-                color,
-                depth,
-                fragment,
-                bins.strip_items(tile)
-                    .iter()
-                    .filter_map(|&i| tris.get(i as usize)),
-                Keep::Pixels,
-            )
-            .0)
+        let items = bins.strip_items(tile).iter();
+        let tris = items.filter_map(|&i| tris.get(i as usize));
+        Ok(self.draw_each(rect, color, depth, fragment, tris, keep).0)
     }
 
     /// [`Frame::render_tile_shaded`] under a deferred clear (see
@@ -402,27 +411,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         if !cfg!(feature = "lazy-clear") {
             return Err(Error::ModeUnsupported);
         }
-        if !bins.belong_to(&self.stage.config, self.store.len) {
-            return Err(Error::BinsMismatch);
-        }
-        let rect = bins.rect(tile);
-        check_rect(&self.stage.config, rect, color.len(), depth.depth_len())?;
-        if lazy.rect != rect {
-            return Err(Error::LazyClearRect);
-        }
-        let tris = self.triangles();
-        Ok(self
-            .draw_each(
-                rect,
-                color,
-                depth,
-                fragment,
-                bins.strip_items(tile)
-                    .iter()
-                    .filter_map(|&i| tris.get(i as usize)),
-                Keep::Lazy(lazy),
-            )
-            .0)
+        self.draw_tile(bins, tile, color, depth, fragment, Keep::Lazy(lazy))
     }
 
     /// Renders rows `y0..y1` of the frame into `color` and `depth`, which

@@ -446,20 +446,6 @@ pub fn draw_layers_cleared<const S: u32, C: PixelFormat + Send + Sync, T: DepthW
         threads,
         clear.is_none(),
         |tile, rect, c, mut d| {
-            let mut written = 0;
-            let Some(v) = clear else {
-                for (frame, bins) in layers {
-                    written += match d.as_deref_mut() {
-                        Some(d) => frame.render_tile(bins, tile, c, d)?.pixels_written,
-                        None => {
-                            frame
-                                .render_tile(bins, tile, c, &mut NoDepth)?
-                                .pixels_written
-                        }
-                    };
-                }
-                return Ok(written);
-            };
             // Tiles of few, large triangles (a quad, a few boxes) defer
             // the clear (`LazyClear`): what the layers reach is cleared as
             // they reach it, the rest after them, so a pixel the first
@@ -470,39 +456,19 @@ pub fn draw_layers_cleared<const S: u32, C: PixelFormat + Send + Sync, T: DepthW
             // are the same either way (`tests/lazy_clear.rs`).
             let area = (rect[1] - rect[0]) as usize * (rect[3] - rect[2]) as usize;
             let items: usize = layers.iter().map(|(_, b)| b.strip_items(tile).len()).sum();
+            let Some(v) = clear else {
+                return draw_tile_layers(layers, tile, c, d, None);
+            };
             if items * LAZY_PIXELS_PER_TRIANGLE > area {
                 c.fill(v);
                 if let Some(d) = d.as_deref_mut() {
                     d.fill(depth_clear);
                 }
-                for (frame, bins) in layers {
-                    written += match d.as_deref_mut() {
-                        Some(d) => frame.render_tile(bins, tile, c, d)?.pixels_written,
-                        None => {
-                            frame
-                                .render_tile(bins, tile, c, &mut NoDepth)?
-                                .pixels_written
-                        }
-                    };
-                }
-                return Ok(written);
+                return draw_tile_layers(layers, tile, c, d, None);
             }
             let mut hull = vec![0u32; (rect[3] - rect[2]) as usize];
             let mut lazy = LazyClear::new(&mut hull, rect, v, depth_clear.to_z32())?;
-            for (frame, bins) in layers {
-                written += match d.as_deref_mut() {
-                    Some(d) => {
-                        frame
-                            .render_tile_lazy(bins, tile, c, d, &mut lazy)?
-                            .pixels_written
-                    }
-                    None => {
-                        frame
-                            .render_tile_lazy(bins, tile, c, &mut NoDepth, &mut lazy)?
-                            .pixels_written
-                    }
-                };
-            }
+            let written = draw_tile_layers(layers, tile, c, d.as_deref_mut(), Some(&mut lazy))?;
             match d {
                 Some(d) => lazy.finish(c, d)?,
                 None => lazy.finish(c, &mut NoDepth)?,
@@ -510,6 +476,29 @@ pub fn draw_layers_cleared<const S: u32, C: PixelFormat + Send + Sync, T: DepthW
             Ok(written)
         },
     )
+}
+
+/// Draws tile `tile` of every layer in turn into `c` and `d` (none: no
+/// depth buffer), under the deferred clear `lazy` where given; returns the
+/// pixels written.
+fn draw_tile_layers<const S: u32, C: PixelFormat, T: DepthWord>(
+    layers: &[Layer<'_, '_, S>],
+    tile: u32,
+    c: &mut [C],
+    mut d: Option<&mut [T]>,
+    mut lazy: Option<&mut LazyClear<'_, C>>,
+) -> Result<u64, Error> {
+    let mut written = 0;
+    for (frame, bins) in layers {
+        let stats = match (d.as_deref_mut(), lazy.as_deref_mut()) {
+            (Some(d), Some(l)) => frame.render_tile_lazy(bins, tile, c, d, l)?,
+            (None, Some(l)) => frame.render_tile_lazy(bins, tile, c, &mut NoDepth, l)?,
+            (Some(d), None) => frame.render_tile(bins, tile, c, d)?,
+            (None, None) => frame.render_tile(bins, tile, c, &mut NoDepth)?,
+        };
+        written += stats.pixels_written;
+    }
+    Ok(written)
 }
 
 // ---------------------------------------------------------------------------
