@@ -31,7 +31,7 @@ use crate::stats::{RenderStats, Stats};
 /// draws into buffers that may hold anything, and [`LazyClear::finish`]
 /// then clears what no triangle reached. The pixels are those of a clear
 /// followed by the same draws ([`Frame::render_tile`]), for any depth
-/// test. Where a flat triangle of a `u16` buffer under
+/// test. Where a flat triangle of a `u16` or `u32` buffer under
 /// [`DepthFunc::Less`](crate::DepthFunc::Less) reaches columns nothing
 /// has reached yet, nearer than the clear depth throughout, its spans are
 /// written without reading the buffers: a full-screen triangle costs one

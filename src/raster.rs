@@ -66,7 +66,7 @@
 //! A deferred clear ([`crate::LazyClear`], `Strip::lazy`) draws into
 //! buffers that hold anything: per row it keeps the columns `[lo, hi]`
 //! that hold the clear or a draw (the hull), and outside them nothing is
-//! read. A triangle of the `u16` `Less` flat path extends the hull span by
+//! read. A triangle of the `u16` or `u32` `Less` flat path extends the hull span by
 //! span: a span beyond the hull whose depth is nearer than the clear
 //! everywhere is written without reading the buffers (every pixel would
 //! pass against the clear), the gap up to the hull cleared; any other
@@ -885,8 +885,11 @@ fn draw_in<
     };
     let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
     #[cfg(feature = "lazy-clear")]
-    if let Some(written) = lazy::enter::<S, N, C, D, R, T>(t, (row_first, row_last), strip, flat) {
-        return written;
+    if strip.lazy.is_some() {
+        let rows = (row_first, row_last);
+        if let Some(written) = lazy::enter::<S, N, C, D, R, T>(t, rows, strip, flat) {
+            return written;
+        }
     }
     if EARLY_FLAT && !smooth && !crosses && t.max_x - t.min_x >= SMALL_WIDTH {
         // Flat spans, the most common case: their loop sets up its own

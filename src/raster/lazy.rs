@@ -18,7 +18,7 @@ pub(crate) struct Lazy<'b, C> {
     pub z32: u32,
 }
 
-/// Where a deferred clear is on: draws a triangle of the flat `Less`
+/// Where a deferred clear is on (the caller has checked): draws a triangle of the flat `Less`
 /// path (`Some(pixels written)`), or extends the hull over the box of any
 /// other triangle on each of its rows `row_first..=row_last`, clearing
 /// what that adds, and leaves the drawing to the usual paths (`None`).
@@ -36,7 +36,6 @@ pub(super) fn enter<
     strip: &mut Strip<'_, C, D>,
     flat: C,
 ) -> Option<u32> {
-    strip.lazy.as_ref()?;
     let smooth = C::SHADED && t.smooth;
     let crosses = (t.min_x as u32) < strip.x0 || (t.max_x as u32) >= strip.x1;
     // The `u16` and `u32` `Less` flat spans keep the hull themselves;
@@ -88,18 +87,41 @@ fn clear_run<C: PixelFormat, D: DepthBuffer + ?Sized>(
     strip.depth.fill_z32(start, len, z32);
 }
 
+/// Row `r`'s hull (`HULL_EMPTY` past the hull, which
+/// `LazyClear::new` sized to the rectangle's rows).
+#[inline]
+fn hull_of<C, D: ?Sized>(strip: &Strip<'_, C, D>, r: usize) -> u32 {
+    strip
+        .lazy
+        .as_ref()
+        .and_then(|l| l.hull.get(r).copied())
+        .unwrap_or(HULL_EMPTY)
+}
+
+/// Sets row `r`'s hull, `h`, to its union with window columns `a..=b`.
+#[inline]
+fn join_hull<C, D: ?Sized>(strip: &mut Strip<'_, C, D>, r: usize, h: u32, a: u32, b: u32) {
+    let (lo, hi) = (h & 0xFFFF, h >> 16);
+    let (lo, hi) = if lo > hi {
+        (a, b)
+    } else {
+        (lo.min(a), hi.max(b))
+    };
+    if let Some(slot) = strip.lazy.as_mut().and_then(|l| l.hull.get_mut(r)) {
+        *slot = lo | hi << 16;
+    }
+}
+
 /// Extends the hull of row `r` over window columns `a..=b`, clearing the
-/// columns that adds; returns the row's hull before.
+/// columns that adds.
 #[inline]
 fn lazy_extend<C: PixelFormat, D: DepthBuffer + ?Sized>(
     strip: &mut Strip<'_, C, D>,
     r: usize,
     a: u32,
     b: u32,
-) -> u32 {
-    let Some(h) = strip.lazy.as_ref().and_then(|l| l.hull.get(r).copied()) else {
-        return HULL_EMPTY;
-    };
+) {
+    let h = hull_of(strip, r);
     let (lo, hi) = (h & 0xFFFF, h >> 16);
     if lo > hi {
         clear_run(strip, r, a, b);
@@ -112,15 +134,7 @@ fn lazy_extend<C: PixelFormat, D: DepthBuffer + ?Sized>(
             clear_run(strip, r, hi + 1, b);
         }
     }
-    let (nlo, nhi) = if lo > hi {
-        (a, b)
-    } else {
-        (lo.min(a), hi.max(b))
-    };
-    if let Some(slot) = strip.lazy.as_mut().and_then(|l| l.hull.get_mut(r)) {
-        *slot = nlo | nhi << 16;
-    }
-    h
+    join_hull(strip, r, h, a, b);
 }
 
 /// The flat span rows of a triangle under a deferred clear
@@ -194,7 +208,7 @@ fn lazy_span<C: PixelFormat, D: DepthBuffer + ?Sized>(
     (start, len, z0, dz): (usize, usize, i64, i64),
     px: C,
 ) -> Option<u32> {
-    let h = strip.lazy.as_ref().and_then(|l| l.hull.get(r).copied())?;
+    let h = hull_of(strip, r);
     let (lo, hi) = (h & 0xFFFF, h >> 16);
     if lo > hi || b < lo || a > hi {
         let z32 = strip.lazy.as_ref().map_or(0, |l| l.z32);
@@ -209,14 +223,7 @@ fn lazy_span<C: PixelFormat, D: DepthBuffer + ?Sized>(
                     clear_run(strip, r, hi + 1, a - 1);
                 }
             }
-            let (nlo, nhi) = if lo > hi {
-                (a, b)
-            } else {
-                (lo.min(a), hi.max(b))
-            };
-            if let Some(slot) = strip.lazy.as_mut().and_then(|l| l.hull.get_mut(r)) {
-                *slot = nlo | nhi << 16;
-            }
+            join_hull(strip, r, h, a, b);
             return Some(n);
         }
     }
