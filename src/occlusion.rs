@@ -14,10 +14,16 @@
 //! that depth fails the depth test against the largest stored depth of
 //! every tile the rectangle touches, no pixel of the object can pass it:
 //! the object is counted in [`Stats::culled_occlusion`] and nothing of it
-//! is transformed. Otherwise it is drawn, and the tiles its rectangle
+//! is transformed. Where a tile's largest depth lets it pass and the
+//! rectangle covers only part of the tile, that part is tested pixel by
+//! pixel against the depth buffer itself (the tile's far pixels may lie
+//! outside the rectangle: a silhouette's background; on the herd of
+//! Spots this hides 63.5 % of the triangles instead of 53.3 %).
+//! Otherwise it is drawn, and the tiles its rectangle
 //! touches are marked stale; a stale tile is read again from the depth
 //! buffer the next time a test needs it. So a test costs the tiles it
-//! touches, and the buffer is read only where something was drawn since.
+//! touches, and the buffer is read only where something was drawn since
+//! or where a tile's maximum did not decide.
 //!
 //! Conservative, so the frame is the one the plain submissions draw
 //! (a property test compares them byte for byte, `tests/occlusion.rs`):
@@ -342,15 +348,40 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
             return false;
         };
         let near = W::from_z32(b.near).key();
+        let passes = |key: u32| near < key || (strict && near == key);
         for ty in ty0..ty1 {
             for tx in tx0..tx1 {
-                let max = self.tile_max(tx, ty);
-                if near < max || (strict && near == max) {
+                if passes(self.tile_max(tx, ty)) && self.part_passes(b, tx, ty, passes) {
                     return false;
                 }
             }
         }
         true
+    }
+
+    /// Whether `passes` holds for the stored key of a pixel of tile `(tx,
+    /// ty)` inside `b`'s rectangle: the exact test where the tile's
+    /// maximum failed. A tile wholly inside the rectangle has its
+    /// maximum's answer; one the rectangle only touches is read again,
+    /// only where it lies.
+    fn part_passes(&self, b: &ScreenBound, tx: u32, ty: u32, passes: impl Fn(u32) -> bool) -> bool {
+        let s = &self.renderer.sink.strip;
+        let (w, h) = (s.x1 - s.x0, s.y1 - s.y0);
+        let (tx0, ty0) = (tx * HIZ_TILE, ty * HIZ_TILE);
+        let (tx1, ty1) = ((tx0 + HIZ_TILE).min(w), (ty0 + HIZ_TILE).min(h));
+        let c0 = b.x0.saturating_sub(s.x0).max(tx0);
+        let c1 = b.x1.saturating_sub(s.x0).min(tx1);
+        let r0 = b.y0.saturating_sub(s.y0).max(ty0);
+        let r1 = b.y1.saturating_sub(s.y0).min(ty1);
+        if (c0, c1, r0, r1) == (tx0, tx1, ty0, ty1) {
+            return true;
+        }
+        (r0..r1).any(|y| {
+            let row = y as usize * s.width;
+            s.depth
+                .get(row + c0 as usize..row + c1 as usize)
+                .is_none_or(|words| words.iter().any(|v| passes(v.key())))
+        })
     }
 
     /// The largest key of tile `(tx, ty)`, read again if stale.

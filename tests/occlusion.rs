@@ -355,3 +355,44 @@ fn an_unbounded_object_refreshes_every_tile() {
         .unwrap());
     assert_eq!(o.stats().culled_occlusion, 12);
 }
+
+/// A tile whose largest depth lets a bound pass, but which the bound's
+/// rectangle covers only in part, is decided by the pixels of that part:
+/// near ones hide the object, and one far pixel inside the rectangle, or
+/// one column more, does not.
+#[test]
+fn a_tile_covered_in_part_is_read_where_the_bound_lies() {
+    use microraster::occlusion::ScreenBound;
+    let config = Config::new(W, H);
+    let mut color = vec![Rgb888::new(0, 0, 0); (W * 16) as usize];
+    // Near (a wall) in columns 0..13, far beyond: tile columns 8..16
+    // hold both.
+    let fill = |depth: &mut [u16]| {
+        for (i, d) in depth.iter_mut().enumerate() {
+            *d = if (i as u32 % W) < 13 { 1000 } else { u16::MAX };
+        }
+    };
+    let mut depth = vec![0u16; (W * 16) as usize];
+    fill(&mut depth);
+    let bound = |x1: u32| ScreenBound {
+        x0: 2,
+        x1,
+        y0: 0,
+        y1: 16,
+        near: 2000 << 16,
+    };
+    let mut tiles = vec![HiZTile::default(); tiles_for(W, 16)];
+    {
+        let mut r = StripRenderer::new(config, 0, 16, &mut color, &mut depth[..]).unwrap();
+        let mut o = r.occluder(&mut tiles).unwrap();
+        assert!(o.hides(&bound(12)));
+        assert!(o.hides(&bound(13)));
+        assert!(!o.hides(&bound(14)));
+    }
+    // One far pixel inside the rectangle, in the straddling tile.
+    depth[(5 * W + 10) as usize] = u16::MAX;
+    let mut r = StripRenderer::new(config, 0, 16, &mut color, &mut depth[..]).unwrap();
+    let mut o = r.occluder(&mut tiles).unwrap();
+    assert!(!o.hides(&bound(12)));
+    assert!(o.hides(&ScreenBound { y0: 6, ..bound(12) }));
+}
