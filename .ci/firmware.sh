@@ -14,7 +14,8 @@
 # and that the unlit and untextured variants link no lighting or texture
 # code), with its own table, and Spot in cluster order on the M4F with
 # the cluster tests of docs/culling.md (the same frame, fewer
-# instructions). Then the configuration sweep of the cubes on
+# instructions), and a herd of Spots with and without occlusion culling
+# on the M4F. Then the configuration sweep of the cubes on
 # the M4F and the M0 (subpixel bits, depth buffer, float backend, the i32
 # edge fast path: the speed axis of `microraster report speed-vs-error`),
 # with its own table of record.
@@ -74,6 +75,9 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
   # Normal masks of Spot, likewise.
   cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-masks -- -D warnings
   cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,cull-masks-frame -- -D warnings
+  # The herd of Spots, with and without occlusion culling, likewise.
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,herd -- -D warnings
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,herd-occlusion -- -D warnings
 )
 
 expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
@@ -408,6 +412,24 @@ for v in "${mask_variants[@]}"; do
   fi
 done
 
+# Occlusion culling (issue 11) on the M4F: a herd of nine Spots, each
+# strip drawing them front to back plainly (`herd`) or through an
+# `Occluder` (`herd-occlusion`); both frames must be the herd's host
+# frame (host-checksums.txt `spot-flat-herd`), counts of record in
+# docs/embedded.md, and the occlusion build must hide something.
+herd_variants=(spot-flat,herd spot-flat,herd-occlusion)
+herd_rows=()
+for v in "${herd_variants[@]}"; do
+  spot_run thumbv7em-none-eabihf mps2-an386 "$v" spot-flat-herd herd_rows || continue
+  case $v in *herd-occlusion)
+    if ! grep -qE '^herd of [0-9]+ Spots: hidden by occlusion before transform [1-9]' "$out"; then
+      echo "FAIL: mps2-an386 $v hid no triangle"
+      failed=1
+    fi
+    ;;
+  esac
+done
+
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
 # the M0, bit-identical to the host's clipless frame, counts of record in
 # docs/embedded.md like the rows above.
@@ -471,6 +493,11 @@ step "Spot, normal masks on the M4F (the same table in docs/embedded.md)"
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${mask_rows[@]}"
+
+step "Spot herd, occlusion culling on the M4F (the same table in docs/embedded.md)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${herd_rows[@]}"
 
 step "Spot, cluster culling on the M4F, camera sweep (the same table in docs/embedded.md)"
 echo "| board | build | cameras | skipped before transform, mean | fewest-most | render a frame, culled | with every cluster | culled / every |"

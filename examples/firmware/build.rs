@@ -124,7 +124,8 @@ const SPOT_ROWS_MPS2: u32 = 16;
 /// With `clusters` (baseline included, so that it draws the same
 /// strips): the eye and the walk of the cluster tree take 336 B more
 /// stack, which at 16 rows would leave `spot-lit` 36 B of the 24 KB and
-/// the textured and Phong shadings none.
+/// the textured and Phong shadings none. With `herd` too: the occluder's
+/// hi-z tiles (640 B) are on the stack.
 const SPOT_ROWS_MPS2_CLUSTERS: u32 = 15;
 const SPOT_ROWS_MICROBIT: u32 = 9;
 
@@ -146,7 +147,7 @@ fn board(target: &str, immediate: bool, spot: bool, depth_u32: bool, clipless: b
             // (the model and texture are in flash).
             match target {
                 "thumbv6m-none-eabi" => SPOT_ROWS_MICROBIT,
-                _ if cfg!(feature = "clusters") => SPOT_ROWS_MPS2_CLUSTERS,
+                _ if cfg!(any(feature = "clusters", feature = "herd")) => SPOT_ROWS_MPS2_CLUSTERS,
                 _ => SPOT_ROWS_MPS2,
             }
         } else if depth_u32 {
@@ -336,12 +337,26 @@ impl spot_scene::Draw for HostFrame {
         mesh: &Mesh<'_, A>,
         fragment: F,
     ) -> u64 {
-        let mut storage = vec![SetupTriangle::<N>::EMPTY; mesh.indices.len() * 7];
+        // With `herd`, every Spot of the herd in its order (ids on from
+        // the one before), as the firmware's strips submit them.
+        let spots = if cfg!(feature = "herd") {
+            spot_scene::HERD.len()
+        } else {
+            1
+        };
+        let mut storage = vec![SetupTriangle::<N>::EMPTY; mesh.indices.len() * 7 * spots];
         let config = Config::new(WIDTH, HEIGHT);
         let mut frame = Frame::<8, N>::with_subpixel_bits(config, &mut storage).unwrap();
-        frame
-            .submit_mesh(mesh, &spot_scene::mvp(WIDTH, HEIGHT), 0)
-            .unwrap();
+        let vp = spot_scene::mvp(WIDTH, HEIGHT);
+        for k in 0..spots {
+            let mvp = if cfg!(feature = "herd") {
+                vp * spot_scene::herd_model(k)
+            } else {
+                vp
+            };
+            let first = (k * mesh.indices.len()) as u32;
+            frame.submit_mesh(mesh, &mvp, first).unwrap();
+        }
         let n = (WIDTH * HEIGHT) as usize;
         let mut color = vec![Rgb565::BLACK; n];
         let mut z = vec![u16::MAX; n];
@@ -477,6 +492,53 @@ fn spot_chunks(model: &spot_scene::Model<'_>) -> String {
         .unwrap();
     }
     s.push_str("];\n");
+    // The runs' boxes and the whole model's sphere and box: what the
+    // `herd` builds' occlusion test projects.
+    let aabb = |points: &mut dyn Iterator<Item = microraster::Vec3>| {
+        let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for p in points {
+            for (a, v) in [p.x, p.y, p.z].into_iter().enumerate() {
+                lo[a] = lo[a].min(v);
+                hi[a] = hi[a].max(v);
+            }
+        }
+        format!(
+            "microraster::occlusion::Aabb::new(microraster::Vec3::new({:?}, {:?}, {:?}), microraster::Vec3::new({:?}, {:?}, {:?}))",
+            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
+        )
+    };
+    let runs = spot_runs(model.indices.len());
+    writeln!(
+        s,
+        "#[allow(dead_code)]\npub static BOXES: [microraster::occlusion::Aabb; {}] = [",
+        runs.len()
+    )
+    .unwrap();
+    for [a, b] in runs {
+        let tris = &model.indices[a..b];
+        let mut points = tris.iter().flatten().map(|&i| model.positions[i as usize]);
+        writeln!(s, "    {},", aabb(&mut points)).unwrap();
+    }
+    s.push_str("];\n");
+    let all: Vec<_> = model
+        .indices
+        .iter()
+        .flatten()
+        .map(|&i| model.positions[i as usize])
+        .collect();
+    let b = microraster::BoundingSphere::from_points(&all).unwrap();
+    writeln!(
+        s,
+        "#[allow(dead_code)]\npub static WHOLE_SPHERE: microraster::BoundingSphere = microraster::BoundingSphere {{ center: microraster::Vec3::new({:?}, {:?}, {:?}), radius: {:?} }};",
+        b.center.x, b.center.y, b.center.z, b.radius
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "#[allow(dead_code)]\npub static WHOLE_BOX: microraster::occlusion::Aabb = {};",
+        aabb(&mut all.iter().copied())
+    )
+    .unwrap();
     #[cfg(feature = "cull-masks")]
     s.push_str(&spot_classes_reordered(model.indices));
     s

@@ -51,7 +51,10 @@
 //! Features `spot-flat`, `spot-gouraud`, `spot-lit`, `spot-textured`,
 //! `spot-textured-lit` and `spot-phong` draw baked Spot instead (`spot.rs`,
 //! `spot_scene.rs`): the model and its texture in flash, immediate mode,
-//! one shading variant per build.
+//! one shading variant per build. With one of them, `clusters` and the
+//! `cull-*` features draw Spot with cluster tests or normal masks, and
+//! `herd` and `herd-occlusion` a herd of nine Spots without and with
+//! occlusion culling (see `docs/culling.md`).
 
 #![no_std]
 #![no_main]

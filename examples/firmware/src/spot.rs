@@ -75,6 +75,10 @@ mod clustered {
 compile_error!("the `clusters` features are for the MPS2 boards (all of Spot)");
 #[cfg(all(feature = "cull-masks", feature = "clusters"))]
 compile_error!("`cull-masks` draws the Morton order, not the clusters");
+#[cfg(all(feature = "herd", any(feature = "clusters", feature = "cull-masks")))]
+compile_error!("`herd` draws the Morton runs with the occlusion test, not clusters or masks");
+#[cfg(all(feature = "herd", small_spot))]
+compile_error!("the `herd` features are for the MPS2 boards (all of Spot)");
 
 /// Spot's normal classes (`microraster bake --normal-masks 16`): the
 /// direction cube and the classes' size bounds and spheres; `chunks`
@@ -142,6 +146,10 @@ const CULL_NAME: &str = if cfg!(feature = "cull-masks-frame") {
     "in Morton order, one normal mask a frame"
 } else if cfg!(feature = "cull-masks") {
     "in Morton order, normal masks of each strip's rows"
+} else if cfg!(feature = "herd-occlusion") {
+    "a herd of 9, in Morton order, occlusion culling"
+} else if cfg!(feature = "herd") {
+    "a herd of 9, in Morton order"
 } else {
     "in Morton order"
 };
@@ -214,6 +222,13 @@ struct Measured {
     one_clear: u64,
     /// The mesh submitted to a one-row strip.
     one_row: u64,
+    /// Triangles the strips' occlusion tests hid, and those they were
+    /// submitted (each strip's submissions counted: `Stats`); printed by
+    /// the `herd` builds.
+    #[cfg_attr(not(feature = "herd"), allow(dead_code))]
+    hidden: u64,
+    #[cfg_attr(not(feature = "herd"), allow(dead_code))]
+    submitted: u64,
     /// With `clusters`: what the cluster test did (see `ClusterCount`).
     #[cfg(feature = "clusters")]
     clusters: ClusterCount,
@@ -281,8 +296,10 @@ impl Draw for Strips<'_> {
         #[allow(clippy::let_unit_value)]
         let drawn = decide(&mvp, &config);
         let strips_start = display.clock.now();
-        let written = frame(config, &mvp, &drawn, color, depth, display, mesh, fragment);
+        let drawn_frame = frame(config, &mvp, &drawn, color, depth, display, mesh, fragment);
         let end = display.clock.now();
+        let (hidden, submitted) = drawn_frame.map_or((0, 0), |f| (f.1, f.2));
+        let written = drawn_frame.map(|f| f.0);
 
         let clock = &mut display.clock;
         let t = clock.now();
@@ -393,6 +410,8 @@ impl Draw for Strips<'_> {
             end,
             one_clear,
             one_row,
+            hidden,
+            submitted,
             #[cfg(feature = "clusters")]
             clusters,
             #[cfg(feature = "cull-masks")]
@@ -501,7 +520,8 @@ impl Default for Sweep {
 }
 
 /// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
-/// push the rows. The pixels written.
+/// push the rows. The pixels written, and the triangles the strips' tests
+/// hid and were submitted (`Stats::culled_occlusion`, `Stats::submitted`).
 #[allow(clippy::too_many_arguments)]
 // Inlined into each caller (the frame of record and the sweep), so that
 // neither's stack sits on top of an out-of-line copy (+650 B measured).
@@ -515,8 +535,12 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
     display: &mut HashDisplay,
     mesh: &Mesh<'_, A>,
     fragment: F,
-) -> Result<u64, &'static str> {
+) -> Result<(u64, u64, u64), &'static str> {
     let mut written = 0;
+    #[cfg(feature = "herd")]
+    let (mut hidden, mut submitted) = (0, 0);
+    #[cfg(not(feature = "herd"))]
+    let (hidden, submitted) = (0, 0);
     let mut y0 = 0;
     while y0 < HEIGHT {
         let y1 = (y0 + STRIP_ROWS as u32).min(HEIGHT);
@@ -529,10 +553,17 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
                 .map_err(|_| "strip renderer")?;
         submit_chunks(&mut strip, mesh, mvp, drawn)?;
         written += strip.render_stats().pixels_written;
+        // Only where printed (the copy of `Stats` moved the cluster
+        // builds' counts by up to 1.7 %).
+        #[cfg(feature = "herd")]
+        {
+            let stats = strip.stats();
+            (hidden, submitted) = (hidden + stats.culled_occlusion, submitted + stats.submitted);
+        }
         push(display, y0, y1, color)?;
         y0 = y1;
     }
-    Ok(written)
+    Ok((written, hidden, submitted))
 }
 
 /// Submits `mesh` as its runs of `CHUNK_TRIANGLES` triangles, each with
@@ -541,7 +572,7 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
 /// transforms their vertices. Triangle ids and order are the whole mesh's.
 /// Inlined: out of line, its frame and `submit_mesh`'s took 860 bytes more
 /// stack (`spot-phong` on the Cortex-M3 overflowed its 24 KB).
-#[cfg(not(any(feature = "clusters", feature = "cull-masks")))]
+#[cfg(not(any(feature = "clusters", feature = "cull-masks", feature = "herd")))]
 #[inline(always)]
 fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
     strip: &mut S,
@@ -558,6 +589,67 @@ fn submit_chunks<S: Submit<8, N>, const N: usize, A: Attributes<N> + Copy>(
         };
         let first = (k * spot_scene::CHUNK_TRIANGLES) as u32;
         strip.submit_mesh(&run, mvp, first).map_err(|_| "submit")?;
+    }
+    Ok(())
+}
+
+/// With `herd`: the herd's Spots (`spot_scene::HERD`), front to back,
+/// each under its own model matrix (`vp` is world to clip), as Morton
+/// runs with their spheres, as the single Spot is drawn (the baseline).
+/// With `herd-occlusion`, through an `Occluder` over the strip (its hi-z
+/// tiles on the stack, 640 bytes): a Spot is tested whole (its sphere and
+/// box), then each run with its sphere and box, before anything of it is
+/// transformed, and skipped if it lies behind what the strip holds.
+/// Conservative, so the frame is the one drawn without it (build.rs's
+/// checksum is of the herd drawn plain).
+#[cfg(feature = "herd")]
+#[inline(always)]
+fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
+    strip: &mut StripRenderer<'_, Rgb565, [u16], 8, N, F>,
+    mesh: &Mesh<'_, A>,
+    vp: &Mat4,
+    _drawn: &Drawn,
+) -> Result<(), &'static str> {
+    let n = mesh.indices.len();
+    let run = |k: usize, j: usize, indices, sphere: &microraster::BoundingSphere| {
+        let run = Mesh {
+            indices,
+            bounds: Some(*sphere),
+            ..*mesh
+        };
+        (run, (k * n + j * spot_scene::CHUNK_TRIANGLES) as u32)
+    };
+    let bounds = chunks::CHUNKS.iter().zip(chunks::BOXES.iter());
+    #[cfg(not(feature = "herd-occlusion"))]
+    for k in 0..spot_scene::HERD.len() {
+        let mvp = *vp * spot_scene::herd_model(k);
+        let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
+        for (j, (indices, (sphere, _))) in runs.zip(bounds.clone()).enumerate() {
+            let (run, first) = run(k, j, indices, sphere);
+            strip.submit_mesh(&run, &mvp, first).map_err(|_| "submit")?;
+        }
+    }
+    #[cfg(feature = "herd-occlusion")]
+    {
+        use microraster::occlusion::{tiles_for, HiZTile};
+        let mut tiles = [HiZTile::default(); tiles_for(WIDTH, STRIP_ROWS as u32)];
+        let mut o = strip.occluder(&mut tiles).map_err(|_| "occluder")?;
+        for k in 0..spot_scene::HERD.len() {
+            let mvp = *vp * spot_scene::herd_model(k);
+            let whole = (&chunks::WHOLE_SPHERE, &chunks::WHOLE_BOX);
+            if o.skips(Some(whole.0), Some(whole.1), &mvp, n as u64) {
+                continue;
+            }
+            let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
+            for (j, (indices, (sphere, aabb))) in runs.zip(bounds.clone()).enumerate() {
+                let (run, first) = run(k, j, indices, sphere);
+                let count = indices.len() as u64;
+                o.submit_bounded(Some(sphere), Some(aabb), &mvp, count, |r| {
+                    r.submit_mesh(&run, &mvp, first)
+                })
+                .map_err(|_| "submit")?;
+            }
+        }
     }
     Ok(())
 }
@@ -856,6 +948,18 @@ fn main() -> ! {
             );
             exit(false)
         }
+    }
+    #[cfg(feature = "herd")]
+    {
+        let (a, b) = ratio(m.hidden * 100, m.submitted);
+        hprintln!(
+            "herd of {} Spots: hidden by occlusion before transform {} of {} triangles submitted to the strips ({}.{} %)",
+            spot_scene::HERD.len(),
+            m.hidden,
+            m.submitted,
+            a,
+            b
+        );
     }
     #[cfg(feature = "cull-masks")]
     {

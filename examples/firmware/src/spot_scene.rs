@@ -102,10 +102,49 @@ pub fn normal_color(n: Vec3) -> Rgb888 {
 }
 
 /// Object to clip space for a `width x height` frame (45 degree vertical
-/// field of view).
+/// field of view); with `herd`, world to clip space (each Spot's
+/// [`herd_model`] goes on the right).
 pub fn mvp(width: u32, height: u32) -> Mat4 {
-    Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
-        * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0))
+    #[cfg(feature = "herd")]
+    return Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 12.0)
+        * Mat4::look_at(HERD_EYE, HERD_TARGET, Vec3::new(0.0, 1.0, 0.0));
+    #[cfg(not(feature = "herd"))]
+    return Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
+        * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0));
+}
+
+/// The `herd` builds' Spots, `(x, z)` of each on the ground (Spot's
+/// box is 0.94 wide and 1.72 long): three rows of three, 1.3 apart
+/// across and 2 deep, listed front to back as the camera sees them, so
+/// that the strips draw the nearest first (what occlusion culling needs
+/// to hide the rest).
+#[allow(dead_code)]
+pub const HERD: [[f32; 2]; 9] = [
+    [0.0, 0.0],
+    [1.3, 0.0],
+    [-1.3, 0.0],
+    [0.0, 2.0],
+    [1.3, 2.0],
+    [-1.3, 2.0],
+    [0.0, 4.0],
+    [1.3, 4.0],
+    [-1.3, 4.0],
+];
+
+/// The herd's camera: in front of the first row, a little right of its
+/// middle, at eye height (Spot's back is at about 0.95, its feet at -0.74).
+#[allow(dead_code)]
+pub const HERD_EYE: Vec3 = Vec3::new(0.4, 0.45, -3.2);
+/// The point the herd's camera looks at: the middle of the herd.
+#[allow(dead_code)]
+pub const HERD_TARGET: Vec3 = Vec3::new(0.0, 0.1, 2.0);
+
+/// Object to world space of the herd's Spot `k` (a translation: normals
+/// and lights stay in object space).
+#[allow(dead_code)]
+pub fn herd_model(k: usize) -> Mat4 {
+    let [x, z] = HERD[k % HERD.len()];
+    Mat4::translation(Vec3::new(x, 0.0, z))
 }
 
 /// Cameras of the cluster builds' sweep: eyes on the circle through
