@@ -167,219 +167,234 @@ impl ScreenBound {
     /// `near` at most as far, or `None`): a property test compares the
     /// two over random boxes, cameras and frame sizes.
     pub fn of_box_f32(aabb: &Aabb, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
-        let lo = [aabb.min.x, aabb.min.y, aabb.min.z];
-        let hi = [aabb.max.x, aabb.max.y, aabb.max.z];
-        if !(lo.iter().chain(&hi).all(|v| v.is_finite())
-            && (0..3).all(|k| lo[k] <= hi[k])
-            && mvp.is_finite())
-        {
-            return None;
-        }
-        // The vertex stage's error (`GAMMA`, 16 u) and this evaluation's
-        // own (four products summed: under 5 u of the magnitude, which is
-        // itself rounded): 32 u.
-        const GAMMA32: f32 = 32.0 / 16_777_216.0;
-        const U: f32 = 1.0 / 16_777_216.0;
-        let m = mvp.rows();
-        // Compared inline, not `f32::min` and `max` (library calls on
-        // Armv7-M: a third of this bound's cost there). Without
-        // `math::fx`'s NaN test (9 % more of the herd's frame on the
-        // M4F): the first argument is never NaN here (the running
-        // extremes start infinite and take only what passes a `<` or `>`,
-        // and the rest are finite), and a NaN second one is passed over,
-        // as `f32::min` passes it over.
-        let max = |a: f32, b: f32| if b > a { b } else { a };
-        let min = |a: f32, b: f32| if b < a { b } else { a };
-        let p_abs = [
-            max(lo[0].abs(), hi[0].abs()),
-            max(lo[1].abs(), hi[1].abs()),
-            max(lo[2].abs(), hi[2].abs()),
-            1.0,
-        ];
-        let mag = |i: usize| -> f32 { (0..4).map(|j| m[i][j].abs() * p_abs[j]).sum() };
-        let err = [
-            mag(0) * GAMMA32,
-            mag(1) * GAMMA32,
-            mag(2) * GAMMA32,
-            mag(3) * GAMMA32,
-        ];
-        let corner = (lo, hi);
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        let mut w_min = f32::INFINITY;
-        for k in 0..8 {
-            let pick = |axis: usize| {
-                if k >> axis & 1 == 0 {
-                    corner.0[axis]
-                } else {
-                    corner.1[axis]
-                }
-            };
-            let q = [pick(0), pick(1), pick(2), 1.0];
-            let row = |i: usize| -> f32 { (0..4).map(|j| m[i][j] * q[j]).sum() };
-            let w = row(3);
-            w_min = min(w_min, w);
-            for (i, (l, h)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
-                let v = row(i) / w;
-                *l = min(*l, v);
-                *h = max(*h, v);
-            }
-        }
-        let w_low = w_min - err[3];
-        if !(w_low > 0.0 && w_low.is_finite()) {
-            return None;
-        }
-        // As in `of_box_f64`, plus the division's rounding (u |x / w|,
-        // taken as 4 u) and this sum's own (the factor 1 + 2^-10).
-        let ndc_err = |i: usize| {
-            let v = max(lo[i].abs(), hi[i].abs());
-            ((err[i] + v * err[3]) / w_low + v * (4.0 * U)) * (1.0 + 1.0 / 1024.0)
-        };
-        let (half_w, half_h) = (config.width as f32 * 0.5, config.height as f32 * 0.5);
-        // One pixel for snapping, the pixel centres and the viewport, and
-        // a hundredth for this viewport transform's rounding (below 2 u
-        // of `MAX_DIMENSION`).
-        let ex = ndc_err(0) * half_w + 1.01;
-        let ey = ndc_err(1) * half_h + 1.01;
-        let px = |v: f32| v * half_w + half_w;
-        let py = |v: f32| half_h - v * half_h;
-        let floor = |v: f32, n: u32| -> u32 {
-            if v.is_nan() {
-                0
-            } else {
-                min(max(v, 0.0), n as f32) as u32
-            }
-        };
-        let ceil = |v: f32, n: u32| -> u32 {
-            if v.is_nan() {
-                n
-            } else {
-                (floor(v, n) + 1).min(n)
-            }
-        };
-        let x0 = floor(px(lo[0]) - ex, config.width);
-        let x1 = ceil(px(hi[0]) + ex, config.width);
-        let y0 = floor(py(hi[1]) - ey, config.height);
-        let y1 = ceil(py(lo[1]) + ey, config.height);
-        // Twice `of_box_f64`'s slack for the depth's evaluation.
-        let z = lo[2] * 0.5 + 0.5 - ndc_err(2) * 0.5 - 1.0 / 524_288.0;
-        if !(ex.is_finite() && ey.is_finite() && z.is_finite()) {
-            return None;
-        }
-        let near = if z <= 0.0 {
-            0
-        } else {
-            ((z * 4_294_967_296.0) as u32).saturating_sub(Z_MARGIN)
-        };
-        Some(ScreenBound {
-            x0,
-            x1,
-            y0,
-            y1,
-            near,
-        })
+        bound_of_box::<f32>(aabb, mvp, config)
     }
 
     /// [`ScreenBound::of_box`] in `f64`: the reference the `f32` path is
     /// tested against, and the bound on 64-bit targets.
     pub fn of_box_f64(aabb: &Aabb, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
-        let lo = [aabb.min.x as f64, aabb.min.y as f64, aabb.min.z as f64];
-        let hi = [aabb.max.x as f64, aabb.max.y as f64, aabb.max.z as f64];
-        if !(lo.iter().chain(&hi).all(|v| v.is_finite())
-            && (0..3).all(|k| lo[k] <= hi[k])
-            && mvp.is_finite())
-        {
-            return None;
-        }
-        let m = mvp.rows();
-        let p_abs = [
-            lo[0].abs().max(hi[0].abs()),
-            lo[1].abs().max(hi[1].abs()),
-            lo[2].abs().max(hi[2].abs()),
-            1.0,
-        ];
-        let mag = |i: usize| -> f64 { (0..4).map(|j| (m[i][j] as f64).abs() * p_abs[j]).sum() };
-        let err = [
-            mag(0) * GAMMA,
-            mag(1) * GAMMA,
-            mag(2) * GAMMA,
-            mag(3) * GAMMA,
-        ];
-        let corner = (lo, hi);
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let mut w_min = f64::INFINITY;
-        for k in 0..8 {
-            let pick = |axis: usize| {
-                if k >> axis & 1 == 0 {
-                    corner.0[axis]
-                } else {
-                    corner.1[axis]
-                }
-            };
-            let q = [pick(0), pick(1), pick(2), 1.0];
-            let row = |i: usize| -> f64 { (0..4).map(|j| m[i][j] as f64 * q[j]).sum() };
-            let w = row(3);
-            w_min = w_min.min(w);
-            for (i, (l, h)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
-                let v = row(i) / w;
-                *l = l.min(v);
-                *h = h.max(v);
-            }
-        }
-        // Every computed w stays positive, with a margin.
-        let w_low = w_min - err[3];
-        if !(w_low > 0.0 && w_low.is_finite()) {
-            return None;
-        }
-        // |x_f / w_f - x / w| <= (e_x + |x / w| e_w) / (w - e_w).
-        let ndc_err = |i: usize| (err[i] + lo[i].abs().max(hi[i].abs()) * err[3]) / w_low;
-        let (half_w, half_h) = (config.width as f64 * 0.5, config.height as f64 * 0.5);
-        // One pixel for snapping (half a subpixel), the pixel centres and
-        // the viewport transform's own rounding.
-        let ex = ndc_err(0) * half_w + 1.0;
-        let ey = ndc_err(1) * half_h + 1.0;
-        let px = |v: f64| v * half_w + half_w;
-        let py = |v: f64| half_h - v * half_h;
-        // Clamped to [0, n] and truncated: the floor; one more for the
-        // ceiling (at most one column or row too many).
-        let floor = |v: f64, n: u32| -> u32 {
-            if v.is_nan() {
-                0
+        bound_of_box::<f64>(aabb, mvp, config)
+    }
+}
+
+/// The float a [`ScreenBound`] is computed in, with the margins for that
+/// computation's own rounding (none beyond the vertex stage's in `f64`,
+/// whose rounding is far below the `f32` vertex stage's error it allows
+/// for).
+trait BoundFloat:
+    Copy
+    + PartialOrd
+    + core::ops::Add<Output = Self>
+    + core::ops::Sub<Output = Self>
+    + core::ops::Mul<Output = Self>
+    + core::ops::Div<Output = Self>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    const HALF: Self;
+    const INFINITY: Self;
+    /// The relative error of a corner's clip coordinates, times their
+    /// magnitudes: the vertex stage's `f32` error (`GAMMA`, 16 u), and in
+    /// `f32` this evaluation's own (four products summed, under 5 u of
+    /// the magnitude, itself rounded): 32 u.
+    const GAMMA: Self;
+    /// The division `x / w`'s own rounding, relative to `|x / w|` (4 u
+    /// in `f32`, 0 in `f64`).
+    const DIVISION: Self;
+    /// A factor on the NDC error for its own sum's rounding (1 + 2^-10 in
+    /// `f32`, 1 in `f64`).
+    const SUM: Self;
+    /// Pixels added for snapping, the pixel centres and the viewport
+    /// transform (and in `f32` a hundredth for this transform's own
+    /// rounding, below 2 u of `MAX_DIMENSION`).
+    const PIXEL: Self;
+    /// Subtracted from the window depth for its `f32` evaluation by the
+    /// vertex stage (a few ulps of 1: 2^-20), twice that in `f32`.
+    const Z_SLACK: Self;
+    /// `2^32`, the scale of `Z32`.
+    const Z32: Self;
+    fn of_f32(v: f32) -> Self;
+    fn of_u32(v: u32) -> Self;
+    fn abs(self) -> Self;
+    fn is_finite(self) -> bool;
+    fn is_nan(self) -> bool;
+    /// Truncated, saturating (`as u32`).
+    fn to_u32(self) -> u32;
+}
+
+impl BoundFloat for f64 {
+    const ZERO: f64 = 0.0;
+    const ONE: f64 = 1.0;
+    const HALF: f64 = 0.5;
+    const INFINITY: f64 = f64::INFINITY;
+    const GAMMA: f64 = GAMMA;
+    const DIVISION: f64 = 0.0;
+    const SUM: f64 = 1.0;
+    const PIXEL: f64 = 1.0;
+    const Z_SLACK: f64 = 1.0 / 1_048_576.0;
+    const Z32: f64 = 4_294_967_296.0;
+    fn of_f32(v: f32) -> f64 {
+        v as f64
+    }
+    fn of_u32(v: u32) -> f64 {
+        v as f64
+    }
+    fn abs(self) -> f64 {
+        f64::abs(self)
+    }
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    fn is_nan(self) -> bool {
+        f64::is_nan(self)
+    }
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+}
+
+impl BoundFloat for f32 {
+    const ZERO: f32 = 0.0;
+    const ONE: f32 = 1.0;
+    const HALF: f32 = 0.5;
+    const INFINITY: f32 = f32::INFINITY;
+    const GAMMA: f32 = 32.0 / 16_777_216.0;
+    const DIVISION: f32 = 4.0 / 16_777_216.0;
+    const SUM: f32 = 1.0 + 1.0 / 1024.0;
+    const PIXEL: f32 = 1.01;
+    const Z_SLACK: f32 = 1.0 / 524_288.0;
+    const Z32: f32 = 4_294_967_296.0;
+    fn of_f32(v: f32) -> f32 {
+        v
+    }
+    fn of_u32(v: u32) -> f32 {
+        v as f32
+    }
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+}
+
+/// [`ScreenBound::of_box`] in `F`.
+#[inline(always)]
+fn bound_of_box<F: BoundFloat>(aabb: &Aabb, mvp: &Mat4, config: &Config) -> Option<ScreenBound> {
+    let lo = [aabb.min.x, aabb.min.y, aabb.min.z].map(F::of_f32);
+    let hi = [aabb.max.x, aabb.max.y, aabb.max.z].map(F::of_f32);
+    if !(lo.iter().chain(&hi).all(|v| v.is_finite())
+        && (0..3).all(|k| lo[k] <= hi[k])
+        && mvp.is_finite())
+    {
+        return None;
+    }
+    // Compared inline, not `f32::min` and `max` (library calls on Armv7-M:
+    // a third of this bound's cost there), and without `math::fx`'s NaN
+    // test (9 % more of the herd's frame on the M4F): the first argument
+    // is never NaN here (the running extremes start infinite and take
+    // only what passes a `<` or `>`, and the rest are finite), and a NaN
+    // second one is passed over, as `f32::min` passes it over.
+    let max = |a: F, b: F| if b > a { b } else { a };
+    let min = |a: F, b: F| if b < a { b } else { a };
+    let m = mvp.rows().map(|r| r.map(F::of_f32));
+    let p_abs = [
+        max(lo[0].abs(), hi[0].abs()),
+        max(lo[1].abs(), hi[1].abs()),
+        max(lo[2].abs(), hi[2].abs()),
+        F::ONE,
+    ];
+    let mag = |i: usize| -> F { (0..4).fold(F::ZERO, |s, j| s + m[i][j].abs() * p_abs[j]) };
+    let err = [
+        mag(0) * F::GAMMA,
+        mag(1) * F::GAMMA,
+        mag(2) * F::GAMMA,
+        mag(3) * F::GAMMA,
+    ];
+    let corner = (lo, hi);
+    let mut lo = [F::INFINITY; 3];
+    let mut hi = [F::ZERO - F::INFINITY; 3];
+    let mut w_min = F::INFINITY;
+    for k in 0..8 {
+        let pick = |axis: usize| {
+            if k >> axis & 1 == 0 {
+                corner.0[axis]
             } else {
-                v.clamp(0.0, n as f64) as u32
+                corner.1[axis]
             }
         };
-        let ceil = |v: f64, n: u32| -> u32 {
-            if v.is_nan() {
-                n
-            } else {
-                (floor(v, n) + 1).min(n)
-            }
-        };
-        let x0 = floor(px(lo[0]) - ex, config.width);
-        let x1 = ceil(px(hi[0]) + ex, config.width);
-        let y0 = floor(py(hi[1]) - ey, config.height);
-        let y1 = ceil(py(lo[1]) + ey, config.height);
-        // Window depth z / w / 2 + 1/2; its f32 evaluation errs by a few
-        // ulps of 1 (2^-20 covers them).
-        let z = lo[2] * 0.5 + 0.5 - ndc_err(2) * 0.5 - 1.0 / 1_048_576.0;
-        if !(ex.is_finite() && ey.is_finite() && z.is_finite()) {
-            return None;
+        let q = [pick(0), pick(1), pick(2), F::ONE];
+        let row = |i: usize| -> F { (0..4).fold(F::ZERO, |s, j| s + m[i][j] * q[j]) };
+        let w = row(3);
+        w_min = min(w_min, w);
+        for (i, (l, h)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
+            let v = row(i) / w;
+            *l = min(*l, v);
+            *h = max(*h, v);
         }
-        let near = if z <= 0.0 {
+    }
+    // Every computed w stays positive, with a margin.
+    let w_low = w_min - err[3];
+    if !(w_low > F::ZERO && w_low.is_finite()) {
+        return None;
+    }
+    // |x_f / w_f - x / w| <= (e_x + |x / w| e_w) / (w - e_w), plus the
+    // division's own rounding and this sum's.
+    let ndc_err = |i: usize| {
+        let v = max(lo[i].abs(), hi[i].abs());
+        ((err[i] + v * err[3]) / w_low + v * F::DIVISION) * F::SUM
+    };
+    let (half_w, half_h) = (
+        F::of_u32(config.width) * F::HALF,
+        F::of_u32(config.height) * F::HALF,
+    );
+    let ex = ndc_err(0) * half_w + F::PIXEL;
+    let ey = ndc_err(1) * half_h + F::PIXEL;
+    let px = |v: F| v * half_w + half_w;
+    let py = |v: F| half_h - v * half_h;
+    // Clamped to [0, n] and truncated: the floor; one more for the
+    // ceiling (at most one column or row too many).
+    let floor = |v: F, n: u32| -> u32 {
+        if v.is_nan() {
             0
         } else {
-            ((z * 4_294_967_296.0).min(4_294_967_295.0) as u32).saturating_sub(Z_MARGIN)
-        };
-        Some(ScreenBound {
-            x0,
-            x1,
-            y0,
-            y1,
-            near,
-        })
+            min(max(v, F::ZERO), F::of_u32(n)).to_u32()
+        }
+    };
+    let ceil = |v: F, n: u32| -> u32 {
+        if v.is_nan() {
+            n
+        } else {
+            (floor(v, n) + 1).min(n)
+        }
+    };
+    let x0 = floor(px(lo[0]) - ex, config.width);
+    let x1 = ceil(px(hi[0]) + ex, config.width);
+    let y0 = floor(py(hi[1]) - ey, config.height);
+    let y1 = ceil(py(lo[1]) + ey, config.height);
+    // Window depth z / w / 2 + 1/2, less its errors.
+    let z = lo[2] * F::HALF + F::HALF - ndc_err(2) * F::HALF - F::Z_SLACK;
+    if !(ex.is_finite() && ey.is_finite() && z.is_finite()) {
+        return None;
     }
+    let near = if z <= F::ZERO {
+        0
+    } else {
+        (z * F::Z32).to_u32().saturating_sub(Z_MARGIN)
+    };
+    Some(ScreenBound {
+        x0,
+        x1,
+        y0,
+        y1,
+        near,
+    })
 }
 
 /// What [`Occluder::test`] found: skip (counted), or draw with this bound.
