@@ -927,7 +927,7 @@ pub struct CullArgs {
     pub detail: u16,
 
     /// Also measure normal masks of these partitions a side (rows "normal
-    /// masks, N"; `--normal-masks` with no list: none).
+    /// masks, N"; `--normal-masks` with no list, after the models: none).
     #[arg(long, value_name = "N,..", value_delimiter = ',', default_value = "4,8,16",
           num_args = 0..=1, value_parser = clap::value_parser!(u8).range(1..=16))]
     pub normal_masks: Vec<u8>,
