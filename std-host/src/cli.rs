@@ -69,6 +69,9 @@ pub enum Command {
     /// Measure cluster culling (culling volumes, normal cones, flat and as a
     /// tree) against per-triangle culling on meshes from many cameras.
     Cull(CullArgs),
+    /// Bake the generated house of `cull --portals` (rooms, cells,
+    /// portals, a camera) into Rust source for the firmware (`include!`).
+    BakeHouse(BakeHouseArgs),
 }
 
 /// The end of `render --help`: which options each source uses.
@@ -856,6 +859,26 @@ pub struct BakeArgs {
     /// size bounds and spheres, for normal masks (`BackMask`).
     #[arg(long, value_name = "N")]
     pub normal_masks: Option<u8>,
+}
+
+/// Options of `microraster bake-house`.
+#[derive(Args, Debug, Clone, PartialEq)]
+pub struct BakeHouseArgs {
+    /// Folder for `house.rs` (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Rooms a side (1 to 8).
+    #[arg(long, value_name = "N", default_value_t = crate::portal::FIRMWARE_ROOMS)]
+    pub rooms: usize,
+
+    /// The camera (`cull --portals`'s camera K of this house).
+    #[arg(long, value_name = "K", default_value_t = crate::portal::FIRMWARE_CAMERA)]
+    pub camera: usize,
+
+    /// Frame size the camera's matrix is for.
+    #[arg(long, value_name = "WxH", default_value = "320x240", value_parser = parse_size)]
+    pub size: (u32, u32),
 }
 
 /// The models `cull` measures by default (in the repository).

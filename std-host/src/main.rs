@@ -21,6 +21,7 @@ fn main() -> ExitCode {
         Command::Report(_) => Err(microraster_host::NO_REPORT.to_string()),
         Command::Bake(args) => microraster_host::bake::run(&args),
         Command::Cull(args) => microraster_host::cull_cmd::run(&args),
+        Command::BakeHouse(args) => microraster_host::portal::bake_run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -20,7 +20,7 @@
 
 use crate::scene::{self, Object, ObjectColors, Scene};
 use microraster::occlusion::Aabb;
-use microraster::pixelcolor::Rgb888;
+use microraster::pixelcolor::{Rgb888, RgbColor};
 use microraster::portal::{Cell, PixelRect, Portal, PortalCount, PortalGraph};
 use microraster::{BoundingSphere, Config, Mat4, Vec3};
 
@@ -337,10 +337,7 @@ impl House {
         inv_w: bool,
         portals: bool,
     ) -> Result<(Scene, PortalReport), String> {
-        let aspect = width as f32 / height as f32;
-        let far = self.n as f32 * ROOM * 1.5 + 2.0;
-        let proj = scene::projection(inv_w, microraster::math::radians(fov), aspect, NEAR, far);
-        let view_proj = proj * scene::look_at(eye, target)?;
+        let view_proj = self.view_proj(eye, target, fov, width, height, inv_w)?;
         let mut report = PortalReport::default();
         let mut reached = vec![true; self.cells.len()];
         if let (true, Some(start)) = (portals, self.room_of(eye)) {
@@ -373,6 +370,239 @@ impl House {
                 clip_tris: Vec::new(),
             },
             report,
+        ))
+    }
+}
+
+/// Rooms a side of the house the firmware draws (`bake-house`): the
+/// `house` scene's.
+pub const FIRMWARE_ROOMS: usize = HOUSE_ROOMS;
+/// The camera of record of the firmware's house ([`house_camera`]`(k, 8)`):
+/// one whose walk reaches five of the 64 rooms (the 64 cameras of `cull
+/// --portals` reach 5.4 on average).
+pub const FIRMWARE_CAMERA: usize = 2;
+/// Cameras of the firmware's sweep: the first of [`house_camera`]'s.
+pub const FIRMWARE_SWEEP: usize = 8;
+
+impl House {
+    /// World to clip for `eye` towards `target`, as [`House::scene`] draws.
+    pub fn view_proj(
+        &self,
+        eye: [f32; 3],
+        target: [f32; 3],
+        fov: f32,
+        width: u32,
+        height: u32,
+        inv_w: bool,
+    ) -> Result<Mat4, String> {
+        let aspect = width as f32 / height as f32;
+        let far = self.n as f32 * ROOM * 1.5 + 2.0;
+        let proj = scene::projection(inv_w, microraster::math::radians(fov), aspect, NEAR, far);
+        Ok(proj * scene::look_at(eye, target)?)
+    }
+
+    /// The objects with their rooms, in drawing order.
+    pub fn objects(&self) -> impl Iterator<Item = (usize, &Object)> {
+        self.objects.iter().map(|(r, o)| (*r, o))
+    }
+
+    /// Rust source (`include!`, `no_std`, plain arrays in flash) of the
+    /// house seen from [`house_camera`]`(camera, n)` in a frame of
+    /// `width x height` (60° vertical field of view): the world-to-clip
+    /// matrix, the eye's cell, every object's vertices (each object's
+    /// equal positions shared, which draws the same pixels), triangles,
+    /// colours (one a triangle), room and bounding sphere, and the cells
+    /// and portals of [`PortalGraph`].
+    pub fn bake_source(&self, camera: usize, width: u32, height: u32) -> Result<String, String> {
+        use crate::bake::f32_literal as f;
+        use std::fmt::Write;
+        let (eye, target) = house_camera(camera, self.n);
+        let start = self
+            .room_of(eye)
+            .ok_or_else(|| format!("camera {camera} is in no room"))?;
+        let vp = self.view_proj(eye, target, 60.0, width, height, false)?;
+        let config = Config::new(width, height);
+        let mut rects = vec![PixelRect::EMPTY; self.cells.len()];
+        let count = self
+            .graph()?
+            .visible(&vp, &config, start, &mut rects)
+            .map_err(|e| e.to_string())?;
+        let v3 = |p: Vec3| format!("Vec3::new({}, {}, {})", f(p.x), f(p.y), f(p.z));
+        let (mut positions, mut indices, mut colors, mut objects) =
+            (String::new(), String::new(), String::new(), String::new());
+        let (mut nv, mut nt, mut nc) = (0usize, 0usize, 0usize);
+        for (room, o) in &self.objects {
+            // Flat objects share equal positions (the same pixels: a
+            // vertex's position alone decides its clip coordinates); the
+            // balls' colours are per vertex, so their vertices stay.
+            let (c, per_vertex) = match &o.colors {
+                ObjectColors::PerTriangle(c) => (c, false),
+                ObjectColors::PerVertex(c) => (c, true),
+            };
+            let mut seen = std::collections::HashMap::new();
+            let mut local = Vec::new();
+            let remap: Vec<u32> = o
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    if per_vertex {
+                        local.push(*p);
+                        return i as u32;
+                    }
+                    let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                    *seen.entry(key).or_insert_with(|| {
+                        local.push(*p);
+                        (local.len() - 1) as u32
+                    })
+                })
+                .collect();
+            let (v0, t0, c0) = (nv, nt, nc);
+            for p in &local {
+                let _ = writeln!(positions, "    {},", v3(*p));
+            }
+            for t in &o.indices {
+                let t = t.map(|i| remap[i as usize]);
+                let _ = writeln!(indices, "    [{}, {}, {}],", t[0], t[1], t[2]);
+            }
+            for col in c {
+                let _ = writeln!(
+                    colors,
+                    "    Rgb888::new({}, {}, {}),",
+                    col.r(),
+                    col.g(),
+                    col.b()
+                );
+            }
+            nv += local.len();
+            nt += o.indices.len();
+            nc += c.len();
+            let b = o.bounds.ok_or("a house object without a bounding sphere")?;
+            let _ = writeln!(
+                objects,
+                "    HouseObject {{ room: {room}, positions: [{v0}, {nv}], triangles: [{t0}, {nt}], colors: [{c0}, {nc}], per_vertex: {per_vertex}, sphere: BoundingSphere {{ center: {}, radius: {} }} }},",
+                v3(b.center),
+                f(b.radius)
+            );
+        }
+        let mut cells = String::new();
+        for c in &self.cells {
+            let _ = writeln!(
+                cells,
+                "    Cell {{ first: {}, count: {} }},",
+                c.first, c.count
+            );
+        }
+        let mut portals = String::new();
+        for p in &self.portals {
+            let _ = writeln!(
+                portals,
+                "    Portal {{ to: {}, bounds: Aabb::new({}, {}) }},",
+                p.to,
+                v3(p.bounds.min),
+                v3(p.bounds.max)
+            );
+        }
+        let mat = |m: &Mat4| {
+            let cols = m
+                .cols
+                .iter()
+                .map(|c| format!("[{}]", c.map(f).join(", ")))
+                .collect::<Vec<_>>()
+                .join(", ");
+            format!("Mat4 {{ cols: [{cols}] }}")
+        };
+        let cols = mat(&vp);
+        let mut sweep = String::new();
+        for k in 0..FIRMWARE_SWEEP {
+            let (eye, target) = house_camera(k, self.n);
+            let start = self
+                .room_of(eye)
+                .ok_or_else(|| format!("camera {k} is in no room"))?;
+            let vp = self.view_proj(eye, target, 60.0, width, height, false)?;
+            let _ = writeln!(
+                sweep,
+                "    HouseCamera {{ view_proj: {}, start: {start} }},",
+                mat(&vp)
+            );
+        }
+        let n = self.n;
+        let reached = rects.iter().filter(|r| !r.is_empty()).count();
+        let (no, ncells, np) = (self.objects.len(), self.cells.len(), self.portals.len());
+        let last = FIRMWARE_SWEEP - 1;
+        Ok(format!(
+            "// Generated by `microraster bake-house --rooms {n} --camera {camera}`: do not edit.\n\
+             // A house of {n}x{n} rooms (`microraster_host::portal::House`, seed 1): {nt} triangles,\n\
+             // {nv} vertices, {no} objects, {ncells} cells, {np} portals; camera {camera}, whose portal\n\
+             // walk reaches {reached} of the {ncells} rooms ({} portal projections).\n\
+             \n\
+             use microraster::occlusion::Aabb;\n\
+             use microraster::pixelcolor::Rgb888;\n\
+             use microraster::portal::{{Cell, Portal}};\n\
+             use microraster::{{BoundingSphere, Mat4, Vec3}};\n\
+             \n\
+             /// Rooms a side.\n\
+             pub const ROOMS: usize = {n};\n\
+             /// The frame the matrix is for.\n\
+             pub const WIDTH: u32 = {width};\n\
+             /// The frame the matrix is for.\n\
+             pub const HEIGHT: u32 = {height};\n\
+             /// The camera: eye and target in world space (60° vertical field of view).\n\
+             pub const EYE: [f32; 3] = [{}, {}, {}];\n\
+             /// The camera's target.\n\
+             pub const TARGET: [f32; 3] = [{}, {}, {}];\n\
+             /// The cell (room) the eye is in.\n\
+             pub const START: usize = {start};\n\
+             /// World to clip (the host's, bit for bit).\n\
+             pub const VIEW_PROJ: Mat4 = {cols};\n\
+             \n\
+             /// A camera: world to clip and the eye's cell.\n\
+             #[derive(Clone, Copy, Debug)]\n\
+             pub struct HouseCamera {{\n    \
+                 pub view_proj: Mat4,\n    \
+                 pub start: usize,\n\
+             }}\n\
+             \n\
+             /// The sweep: cameras 0 to {last} of `cull --portals` in this house.\n\
+             pub static SWEEP: [HouseCamera; {FIRMWARE_SWEEP}] = [\n{sweep}];\n\
+             \n\
+             /// One object: its room, its ranges of `POSITIONS`, `INDICES` (which\n\
+             /// count from its first vertex) and `COLORS` (one a vertex if\n\
+             /// `per_vertex`, else one a triangle), its sphere.\n\
+             #[derive(Clone, Copy, Debug)]\n\
+             pub struct HouseObject {{\n    \
+                 pub room: u16,\n    \
+                 pub positions: [u32; 2],\n    \
+                 pub triangles: [u32; 2],\n    \
+                 pub colors: [u32; 2],\n    \
+                 pub per_vertex: bool,\n    \
+                 pub sphere: BoundingSphere,\n\
+             }}\n\
+             \n\
+             /// Object space is world space.\n\
+             pub static POSITIONS: [Vec3; {nv}] = [\n{positions}];\n\
+             \n\
+             /// Triangles, indices into their object's positions.\n\
+             pub static INDICES: [[u32; 3]; {nt}] = [\n{indices}];\n\
+             \n\
+             /// Colours (lit once, when generated).\n\
+             pub static COLORS: [Rgb888; {nc}] = [\n{colors}];\n\
+             \n\
+             /// The objects in drawing order.\n\
+             pub static OBJECTS: [HouseObject; {no}] = [\n{objects}];\n\
+             \n\
+             /// A cell a room (`room = i * ROOMS + j`).\n\
+             pub static CELLS: [Cell; {ncells}] = [\n{cells}];\n\
+             \n\
+             /// Each door's two portals, one out of each room.\n\
+             pub static PORTALS: [Portal; {np}] = [\n{portals}];\n",
+            count.projected,
+            f(eye[0]),
+            f(eye[1]),
+            f(eye[2]),
+            f(target[0]),
+            f(target[1]),
+            f(target[2]),
         ))
     }
 }
@@ -779,4 +1009,33 @@ pub fn markdown(r: &PortalRow, n: usize, cameras: usize, size: (u32, u32)) -> St
         if r.identical { "yes" } else { "NO" }
     );
     t
+}
+
+/// `microraster bake-house`: writes `house.rs` into `args.out` (nothing
+/// if the bake fails) and prints what it holds.
+pub fn bake_run(args: &crate::cli::BakeHouseArgs) -> Result<(), String> {
+    // The firmware keeps a bit a room in a `u64`.
+    if !(1..=8).contains(&args.rooms) {
+        return Err(format!("--rooms must be 1 to 8, got {}", args.rooms));
+    }
+    let house = House::generate(args.rooms, 1);
+    let (w, h) = args.size;
+    let src = house.bake_source(args.camera, w, h)?;
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        format!(
+            "{}: cannot create the output folder: {e}",
+            args.out.display()
+        )
+    })?;
+    let path = args.out.join("house.rs");
+    crate::output::write_all(&[crate::output::Output {
+        option: "--out",
+        path: &path,
+        payload: crate::output::Payload::Raw(src.as_bytes()),
+    }])?;
+    println!("wrote {}", path.display());
+    if let Some(line) = src.lines().nth(1) {
+        println!("{}", line.trim_start_matches("// "));
+    }
+    Ok(())
 }

@@ -938,3 +938,41 @@ fn cull_detail_drops_far_objects_and_boxes_draw_them() {
     assert!(stderr(&o).contains("--cull-detail"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// `bake-house` writes `house.rs` (the firmware's baked house, for any
+/// size and camera) and nothing when it fails: too many rooms for the
+/// firmware's bits, or a frame size the core refuses.
+#[test]
+fn bake_house_writes_the_house_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("baked");
+    let o = ok(&[
+        "bake-house",
+        "--out",
+        out.to_str().unwrap(),
+        "--rooms",
+        "2",
+        "--camera",
+        "5",
+    ]);
+    assert!(
+        stdout(&o).contains("A house of 2x2 rooms"),
+        "{}",
+        stdout(&o)
+    );
+    let src = std::fs::read_to_string(out.join("house.rs")).unwrap();
+    assert!(src.contains("--rooms 2 --camera 5"));
+    assert!(src.contains("pub static PORTALS: [Portal; "));
+    for bad in [
+        &["--rooms", "9"][..],
+        &["--rooms", "0"],
+        &["--size", "0x240"],
+    ] {
+        let fresh = dir.path().join("none");
+        let mut args = vec!["bake-house", "--out", fresh.to_str().unwrap()];
+        args.extend_from_slice(bad);
+        let o = run(&args);
+        assert_ne!(o.status.code(), Some(0), "{bad:?}");
+        assert!(!fresh.join("house.rs").exists(), "{bad:?}");
+    }
+}

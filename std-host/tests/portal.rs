@@ -120,3 +120,181 @@ fn eye_in_no_room_skips_nothing() {
     assert_eq!(house.room_of([2.0, 1.6, 6.0]), Some(1));
     assert_eq!(house.room_of([6.0, 1.6, 2.0]), Some(3));
 }
+
+/// The firmware's house (`examples/firmware/baked/house.rs`) is what
+/// `microraster bake-house` writes today: the generator's 4x4 house and
+/// camera of record, byte for byte (run `microraster bake-house --out
+/// examples/firmware/baked` after changing the generator).
+#[test]
+fn firmware_house_bake_is_current() {
+    use microraster_host::portal::{FIRMWARE_CAMERA, FIRMWARE_ROOMS};
+    let baked = include_str!("../../examples/firmware/baked/house.rs");
+    let now = House::generate(FIRMWARE_ROOMS, 1)
+        .bake_source(FIRMWARE_CAMERA, 320, 240)
+        .unwrap();
+    assert!(
+        now == baked,
+        "examples/firmware/baked/house.rs is stale: run microraster bake-house --out examples/firmware/baked"
+    );
+}
+
+/// The firmware's house frame from the generator itself (its objects,
+/// unshared vertices, through `House::scene`), drawn as the firmware
+/// draws it (`Rgb565`, `u16` depth, 15-row strips, immediate mode) with
+/// every room and with the rooms the walk reaches: both give
+/// `examples/firmware/host-checksums.txt`'s `house`, which
+/// `.ci/firmware.sh` holds both firmware builds to.
+#[test]
+fn firmware_house_frame_is_the_checksum_of_record() {
+    use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
+    use microraster::{Config, Mesh, StripRenderer, Submit};
+    use microraster_host::portal::{FIRMWARE_CAMERA, FIRMWARE_ROOMS};
+    use microraster_scenes::checksum::FrameChecksum;
+    let checksums = include_str!("../../examples/firmware/host-checksums.txt");
+    let want = checksums
+        .lines()
+        .find_map(|l| l.strip_prefix("house "))
+        .map(|v| u64::from_str_radix(v.trim().trim_start_matches("0x"), 16).unwrap())
+        .expect("a house line in host-checksums.txt");
+    let house = House::generate(FIRMWARE_ROOMS, 1);
+    let (eye, target) = house_camera(FIRMWARE_CAMERA, FIRMWARE_ROOMS);
+    let (w, h) = (320u32, 240u32);
+    let config = Config::new(w, h);
+    for portals in [false, true] {
+        let (scene, report) = house
+            .scene(eye, target, 60.0, w, h, false, portals)
+            .unwrap();
+        assert_eq!(report.count.is_some(), portals);
+        let mut sum = FrameChecksum::new();
+        for y0 in (0..h).step_by(15) {
+            let y1 = (y0 + 15).min(h);
+            let n = (w * (y1 - y0)) as usize;
+            let (mut color, mut depth) = (vec![Rgb565::BLACK; n], vec![u16::MAX; n]);
+            let mut strip = StripRenderer::new(config, y0, y1, &mut color, &mut depth[..]).unwrap();
+            for o in &scene.objects {
+                let mesh = Mesh {
+                    positions: &o.positions,
+                    indices: &o.indices,
+                    attributes: o.colors.as_mesh_colors(),
+                    bounds: o.bounds,
+                };
+                strip.submit_mesh(&mesh, &o.mvp, 0).unwrap();
+            }
+            sum.extend(color.iter().map(|p| p.into_storage()));
+        }
+        assert_eq!(
+            sum.value(),
+            want,
+            "house (portals {portals}): {:#018x}, host-checksums.txt says {want:#018x}",
+            sum.value()
+        );
+    }
+}
+
+/// The house drawn strip by strip (`rows` a strip, `Rgb565`), every
+/// object through a `StripRenderer` at `S` subpixel bits into a depth
+/// buffer of `Z` cleared to `far`; with `rects`, a strip skips the objects
+/// of every room whose rectangle from the portal walk misses its rows (as
+/// the firmware's `house-portals` does). The colour and depth of the frame.
+fn strip_frame<const S: u32, Z: Copy>(
+    house: &House,
+    view_proj: &microraster::Mat4,
+    (w, h): (u32, u32),
+    rows: u32,
+    rects: Option<&[microraster::portal::PixelRect]>,
+    far: Z,
+) -> (Vec<u16>, Vec<Z>)
+where
+    [Z]: microraster::DepthBuffer,
+{
+    use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
+    use microraster::{Config, Mesh, StripRenderer, Submit};
+    let config = Config::new(w, h);
+    let (mut color, mut depth) = (Vec::new(), Vec::new());
+    for y0 in (0..h).step_by(rows as usize) {
+        let y1 = (y0 + rows).min(h);
+        let n = (w * (y1 - y0)) as usize;
+        let (mut c, mut z) = (vec![Rgb565::BLACK; n], vec![far; n]);
+        let mut strip =
+            StripRenderer::<_, _, S>::with_subpixel_bits(config, y0, y1, &mut c, &mut z[..])
+                .unwrap();
+        for (room, o) in house.objects() {
+            if rects.is_some_and(|r| !r[room].meets_rows(y0, y1)) {
+                continue;
+            }
+            let mesh = Mesh {
+                positions: &o.positions,
+                indices: &o.indices,
+                attributes: o.colors.as_mesh_colors(),
+                bounds: o.bounds,
+            };
+            strip.submit_mesh(&mesh, view_proj, 0).unwrap();
+        }
+        color.extend(c.iter().map(|p| p.into_storage()));
+        depth.extend(z);
+    }
+    (color, depth)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    /// The firmware's finer use of the walk: a strip draws a room only if
+    /// the room's rectangle meets the strip's rows. Every pixel where a
+    /// room is the nearest surface lies in its rectangle (the walk's
+    /// claim), so the frame is the one drawn with every room in every
+    /// strip, colour and depth, for any strip height.
+    #[test]
+    fn rooms_outside_a_strip_change_no_pixel(
+        seed in any::<u64>(),
+        n in 2usize..6,
+        room in any::<u16>(),
+        fx in 0.0f32..1.0,
+        fz in 0.0f32..1.0,
+        yaw in 0.0f32..std::f32::consts::TAU,
+        pitch in -0.4f32..0.4,
+        eye_y in 0.5f32..2.1,
+        rows in 1u32..40,
+        s8 in any::<bool>(),
+        u32_depth in any::<bool>(),
+    ) {
+        use microraster::portal::PixelRect;
+        let house = House::generate(n, seed);
+        let room = room as usize % (n * n);
+        let (i, j) = (room / n, room % n);
+        let inner = ROOM - WALL - 2.0 * CAMERA_MARGIN;
+        let x = i as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fx * inner;
+        let z = j as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fz * inner;
+        let eye = [x, eye_y, z];
+        let target = [x + yaw.cos(), eye_y + pitch, z + yaw.sin()];
+        let size = (96, 72);
+        let vp = house.view_proj(eye, target, 60.0, size.0, size.1, false).unwrap();
+        let mut rects = vec![PixelRect::EMPTY; n * n];
+        let start = house.room_of(eye).unwrap();
+        house
+            .graph()
+            .unwrap()
+            .visible(&vp, &microraster::Config::new(size.0, size.1), start, &mut rects)
+            .unwrap();
+        let (all, culled) = match (s8, u32_depth) {
+            (true, false) => {
+                let f = |r| { let (c, z) = strip_frame::<8, u16>(&house, &vp, size, rows, r, u16::MAX); (c, z.into_iter().map(u32::from).collect::<Vec<_>>()) };
+                (f(None), f(Some(&rects[..])))
+            }
+            (false, false) => {
+                let f = |r| { let (c, z) = strip_frame::<4, u16>(&house, &vp, size, rows, r, u16::MAX); (c, z.into_iter().map(u32::from).collect::<Vec<_>>()) };
+                (f(None), f(Some(&rects[..])))
+            }
+            (true, true) => {
+                let f = |r| strip_frame::<8, u32>(&house, &vp, size, rows, r, u32::MAX);
+                (f(None), f(Some(&rects[..])))
+            }
+            (false, true) => {
+                let f = |r| strip_frame::<4, u32>(&house, &vp, size, rows, r, u32::MAX);
+                (f(None), f(Some(&rects[..])))
+            }
+        };
+        prop_assert!(all.0 == culled.0, "colour, eye {:?} target {:?} rows {}", eye, target, rows);
+        prop_assert!(all.1 == culled.1, "depth, eye {:?} target {:?} rows {}", eye, target, rows);
+    }
+}
