@@ -78,6 +78,9 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
   # The herd of Spots, with and without occlusion culling, likewise.
   cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,herd -- -D warnings
   cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,herd-occlusion -- -D warnings
+  # The house, with and without portal culling, likewise.
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features house -- -D warnings
+  cargo clippy -q --release --target thumbv7em-none-eabihf --features house-portals -- -D warnings
 )
 
 expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
@@ -324,7 +327,7 @@ done
 spot_run() {
   local target=$1 board=$2 v=$3 key=$4
   local -n table=$5
-  step "$board ($target), Spot: $v"
+  case $v in house*) step "$board ($target), the house: $v" ;; *) step "$board ($target), Spot: $v" ;; esac
   out=$log/$board-${v//,/+}.txt
   set +e
   timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
@@ -430,6 +433,37 @@ for v in "${herd_variants[@]}"; do
   esac
 done
 
+# Portal culling (issue 11) on the M4F: the host's 8x8 house
+# (baked/house.rs, `microraster bake-house`), every room in every strip
+# (`house`) or the rooms whose rectangle from the portal walk meets the
+# strip (`house-portals`); both frames must be the house drawn whole
+# (host-checksums.txt `house`, which std-host/tests/portal.rs computes
+# from the generator), counts of record in docs/embedded.md. The portal
+# build must skip something, and its sweep of 8 cameras compares each
+# culled frame with the whole one on the board (a difference fails it).
+house_variants=(house house-portals)
+house_rows=()
+house_sweep_rows=()
+for v in "${house_variants[@]}"; do
+  spot_run thumbv7em-none-eabihf mps2-an386 "$v" house house_rows || continue
+  case $v in house-portals)
+    if ! grep -qE '^portals: [0-9]+ of [0-9]+ rooms reached, skipped before transform [1-9]' "$out"; then
+      echo "FAIL: mps2-an386 $v skipped no triangle"
+      failed=1
+    fi
+    sweep=$(sed -nE 's/^sweep of ([0-9]+) cameras: ([0-9.]+) rooms reached, skipped before transform ([0-9.]+) %; render a frame ([0-9]+) culled, ([0-9]+) with every room \(([0-9.]+)x\)$/\1 \2 \3 \4 \5 \6/p' "$out")
+    if [ -z "$sweep" ]; then
+      echo "FAIL: mps2-an386 $v printed no camera sweep"
+      failed=1
+      continue
+    fi
+    read -r cams reached mean culled every ratio <<<"$sweep"
+    house_sweep_rows+=("| mps2-an386 | $v (sweep) | $cams | $mean % | $reached | $culled | $every | $ratio |")
+    check_sweep mps2-an386 "$v (sweep)" "$culled $every" || failed=1
+    ;;
+  esac
+done
+
 # The clipless mode (issue 12): the cubes in immediate mode on the M4F and
 # the M0, bit-identical to the host's clipless frame, counts of record in
 # docs/embedded.md like the rows above.
@@ -498,6 +532,16 @@ step "Spot herd, occlusion culling on the M4F (the same table in docs/embedded.m
 echo "$table_header"
 echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 printf '%s\n' "${herd_rows[@]}"
+
+step "the house, portal culling on the M4F (the same table in docs/embedded.md)"
+echo "$table_header"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${house_rows[@]}"
+
+step "the house, portal culling on the M4F, camera sweep (the same table in docs/embedded.md)"
+echo "| board | build | cameras | skipped before transform, mean | rooms reached, mean | render a frame, culled | with every room | culled / every |"
+echo "|---|---|---:|---:|---:|---:|---:|---:|"
+printf '%s\n' "${house_sweep_rows[@]}"
 
 step "Spot, cluster culling on the M4F, camera sweep (the same table in docs/embedded.md)"
 echo "| board | build | cameras | skipped before transform, mean | fewest-most | render a frame, culled | with every cluster | culled / every |"

@@ -32,15 +32,19 @@
 //! With `clusters` (and `cull-*`) the triangles are in the baked cluster
 //! order (`baked/spot_clusters.rs`) and the frame is drawn unculled here:
 //! the firmware's cluster tests must leave it unchanged.
+//!
+//! With `house` the frame is the baked house (`baked/house.rs`) drawn
+//! whole, set up once in a `Frame`: the firmware's portal test must leave
+//! it unchanged.
 
 use microraster::pixelcolor::{IntoStorage, Rgb565, RgbColor};
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 use microraster::NoDepth;
 #[cfg(feature = "spot")]
 use microraster::{Attributes, FragmentShader, Mesh};
 use microraster::{Config, Frame, SetupTriangle, Submit};
 use microraster_scenes::checksum::FrameChecksum;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 use microraster_scenes::cubes;
 use std::env;
 use std::fmt::Write as _;
@@ -147,7 +151,14 @@ fn board(target: &str, immediate: bool, spot: bool, depth_u32: bool, clipless: b
             // (the model and texture are in flash).
             match target {
                 "thumbv6m-none-eabi" => SPOT_ROWS_MICROBIT,
-                _ if cfg!(any(feature = "clusters", feature = "herd")) => SPOT_ROWS_MPS2_CLUSTERS,
+                _ if cfg!(any(
+                    feature = "clusters",
+                    feature = "herd",
+                    feature = "house"
+                )) =>
+                {
+                    SPOT_ROWS_MPS2_CLUSTERS
+                }
                 _ => SPOT_ROWS_MPS2,
             }
         } else if depth_u32 {
@@ -224,7 +235,7 @@ fn frame_checksum(pixels: &[Rgb565]) -> u64 {
 /// The cubes' frame settings and their matrices, with the same callback
 /// as `cubes::for_each_cube`: window z, or with `inv-w` 1/w depth
 /// (`DepthFunc::Greater`).
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 fn cubes_config(
     mut draw: impl FnMut(&microraster::Mesh<'static>, &microraster::Mat4, u32),
 ) -> Config {
@@ -242,10 +253,10 @@ fn cubes_config(
 }
 
 /// The depth buffer's clear value as a `Z32` (0 for 1/w depth).
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 const CLEAR_Z32: u32 = if cfg!(feature = "inv-w") { 0 } else { u32::MAX };
 
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 fn host_checksum(depth: bool) -> u64 {
     if cfg!(feature = "clipless") {
         return clipless_checksum(depth);
@@ -271,7 +282,7 @@ fn host_checksum(depth: bool) -> u64 {
 }
 
 /// The cubes in the clipless mode, drawn whole by one strip renderer.
-#[cfg(not(feature = "spot"))]
+#[cfg(not(any(feature = "spot", feature = "house")))]
 fn clipless_checksum(depth: bool) -> u64 {
     let mut config = cubes_config(|_, _, _| {});
     config.mode = microraster::RasterMode::Clipless;
@@ -291,6 +302,48 @@ fn clipless_checksum(depth: bool) -> u64 {
             microraster::StripRenderer::new(config, 0, HEIGHT, &mut color, &mut none).unwrap();
         draw(&mut |m, mvp, id| r.submit_mesh(m, mvp, id).unwrap());
     }
+    frame_checksum(&color)
+}
+
+/// The baked house (`microraster bake-house`), for the `house` features.
+#[cfg(feature = "house")]
+#[allow(dead_code)]
+mod house {
+    include!("baked/house.rs");
+}
+
+/// The house drawn whole (every room, no portal test) by the other path:
+/// every object set up once in a `Frame`, rendered as one 240-row strip.
+#[cfg(feature = "house")]
+fn house_checksum() -> u64 {
+    use microraster::MeshColors;
+    assert_eq!((house::WIDTH, house::HEIGHT), (WIDTH, HEIGHT));
+    let mut storage = vec![SetupTriangle::EMPTY; 2 * house::INDICES.len()];
+    let config = Config::new(WIDTH, HEIGHT);
+    let mut frame = Frame::<8>::with_subpixel_bits(config, &mut storage).unwrap();
+    for o in &house::OBJECTS {
+        let range = |r: [u32; 2]| r[0] as usize..r[1] as usize;
+        let colors = &house::COLORS[range(o.colors)];
+        let mesh = microraster::Mesh {
+            positions: &house::POSITIONS[range(o.positions)],
+            indices: &house::INDICES[range(o.triangles)],
+            attributes: if o.per_vertex {
+                MeshColors::PerVertex(colors)
+            } else {
+                MeshColors::PerTriangle(colors)
+            },
+            bounds: Some(o.sphere),
+        };
+        frame
+            .submit_mesh(&mesh, &house::VIEW_PROJ, o.triangles[0])
+            .unwrap();
+    }
+    let n = (WIDTH * HEIGHT) as usize;
+    let mut color = vec![Rgb565::BLACK; n];
+    let mut z = vec![u16::MAX; n];
+    frame
+        .render_rows(0, HEIGHT, &mut color, &mut z[..])
+        .unwrap();
     frame_checksum(&color)
 }
 
@@ -582,10 +635,24 @@ fn main() {
              the micro:bit's decimated Spot has no cluster bake"
         );
     }
+    // A baked scene (Spot or the house) instead of the cubes.
+    println!("cargo::rustc-check-cfg=cfg(baked)");
+    if spot || cfg!(feature = "house") {
+        println!("cargo::rustc-cfg=baked");
+    }
+    if small && cfg!(feature = "house") {
+        panic!("the `house` features are for the MPS2 boards (the house does not fit the micro:bit's flash)");
+    }
     let depth_u32 = env::var_os("CARGO_FEATURE_DEPTH_U32").is_some();
     let clipless = env::var_os("CARGO_FEATURE_CLIPLESS").is_some();
-    let b = board(&target, immediate, spot, depth_u32, clipless);
-    #[cfg(not(feature = "spot"))]
+    let b = board(
+        &target,
+        immediate,
+        spot || cfg!(feature = "house"),
+        depth_u32,
+        clipless,
+    );
+    #[cfg(not(any(feature = "spot", feature = "house")))]
     let depth = env::var_os("CARGO_FEATURE_NO_DEPTH").is_none();
 
     let memory = fs::read_to_string(format!("memory/{}", b.memory)).unwrap();
@@ -594,7 +661,9 @@ fn main() {
 
     #[cfg(feature = "spot")]
     let checksum = spot_frame(&out, small);
-    #[cfg(not(feature = "spot"))]
+    #[cfg(feature = "house")]
+    let checksum = house_checksum();
+    #[cfg(not(any(feature = "spot", feature = "house")))]
     let checksum = host_checksum(depth);
     let mut s = String::new();
     writeln!(

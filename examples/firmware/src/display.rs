@@ -36,7 +36,7 @@ pub enum DisplayError {
 }
 
 /// A frame in progress, set aside ([`HashDisplay::save`]).
-#[cfg(feature = "clusters")]
+#[cfg(any(feature = "clusters", feature = "house-portals"))]
 #[derive(Clone, Copy, Default)]
 pub struct Saved {
     next_row: u32,
@@ -73,7 +73,7 @@ impl HashDisplay {
 
     /// The frame received so far (checksum state, rows, pushes, ticks),
     /// to set aside while other frames go through the same display.
-    #[cfg(feature = "clusters")]
+    #[cfg(any(feature = "clusters", feature = "house-portals"))]
     pub fn save(&self) -> Saved {
         Saved {
             next_row: self.next_row,
@@ -84,7 +84,7 @@ impl HashDisplay {
     }
 
     /// Puts a saved frame back (a new frame: `Saved::default()`).
-    #[cfg(feature = "clusters")]
+    #[cfg(any(feature = "clusters", feature = "house-portals"))]
     pub fn restore(&mut self, s: Saved) {
         (self.next_row, self.sum, self.pushes, self.ticks) = (s.next_row, s.sum, s.pushes, s.ticks);
     }

@@ -54,7 +54,10 @@
 //! one shading variant per build. With one of them, `clusters` and the
 //! `cull-*` features draw Spot with cluster tests or normal masks, and
 //! `herd` and `herd-occlusion` a herd of nine Spots without and with
-//! occlusion culling (see `docs/culling.md`).
+//! occlusion culling (see `docs/culling.md`). Features `house` and
+//! `house-portals` draw a baked house of rooms and doors without and with
+//! portal culling (`house.rs`). Where the cubes' code is left out, the
+//! build script sets `cfg(baked)` (a baked scene: Spot or the house).
 
 #![no_std]
 #![no_main]
@@ -65,48 +68,49 @@ mod display;
 mod spot;
 #[cfg(feature = "spot")]
 mod spot_scene;
+#[cfg(feature = "house")]
+mod house;
 
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use clock::Clock;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use cortex_m_semihosting::hprintln;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use display::HashDisplay;
-#[cfg(all(feature = "flat", not(feature = "spot")))]
+#[cfg(all(feature = "flat", not(baked)))]
 use microraster::pixelcolor::Rgb888;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use microraster::pixelcolor::{Rgb565, RgbColor};
-#[cfg(not(any(feature = "immediate", feature = "spot")))]
+#[cfg(not(any(feature = "immediate", baked)))]
 use microraster::SetupTriangle;
-#[cfg(all(feature = "immediate", not(feature = "spot")))]
+#[cfg(all(feature = "immediate", not(baked)))]
 use microraster::StripRenderer;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use microraster::{Config, ProcessedVertex, StripDrawer, Submit};
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 use microraster_scenes::cubes;
 use panic_semihosting as _;
 
-#[cfg(all(feature = "tiles", any(feature = "immediate", feature = "spot")))]
+#[cfg(all(feature = "spot", feature = "house"))]
+compile_error!("`house` draws the house, not Spot: build one of them");
+#[cfg(all(feature = "tiles", any(feature = "immediate", baked)))]
 compile_error!("`tiles` is for the cubes set up once (not `immediate`, `clipless` or `spot-*`)");
-#[cfg(all(feature = "subpixel4", any(feature = "immediate", feature = "spot")))]
+#[cfg(all(feature = "subpixel4", any(feature = "immediate", baked)))]
 compile_error!("`subpixel4` is for the cubes set up once (not `immediate` or `spot-*`)");
-#[cfg(all(feature = "depth-u32", any(feature = "no-depth", feature = "spot")))]
+#[cfg(all(feature = "depth-u32", any(feature = "no-depth", baked)))]
 compile_error!("`depth-u32` is for the cubes with a depth buffer (not `no-depth` or `spot-*`)");
 
 /// Subpixel bits of the frame (`subpixel4`: 4, else 8).
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 const SUBPIXEL: u32 = if cfg!(feature = "subpixel4") { 4 } else { 8 };
 
 /// The depth buffer's word (`depth-u32`: `u32`, else `u16`).
-#[cfg(not(any(feature = "spot", feature = "no-depth", feature = "depth-u32")))]
+#[cfg(not(any(baked, feature = "no-depth", feature = "depth-u32")))]
 type DepthWord = u16;
-#[cfg(all(
-    not(any(feature = "spot", feature = "no-depth")),
-    feature = "depth-u32"
-))]
+#[cfg(all(not(any(baked, feature = "no-depth")), feature = "depth-u32"))]
 type DepthWord = u32;
 
 // BOARD, CORE, STRIP_ROWS and HOST_CHECKSUM, written by build.rs.
@@ -133,15 +137,15 @@ const STRIP_LEN: usize = WIDTH as usize * STRIP_ROWS;
 /// Set-up triangles the frame can hold: the four cubes' 48 triangles,
 /// of which at most half face the camera (the rest are culled as back
 /// faces before storage), with room for clipped pieces.
-#[cfg(not(any(feature = "immediate", feature = "spot")))]
+#[cfg(not(any(feature = "immediate", baked)))]
 const SETUP_CAPACITY: usize = 32;
 
 /// The strip buffer's pixel: the display's own `Rgb565`, or with `flat`
 /// [`Flat565`].
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 #[cfg(not(feature = "flat"))]
 type StripPixel = Rgb565;
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 #[cfg(feature = "flat")]
 type StripPixel = Flat565;
 
@@ -170,7 +174,7 @@ impl From<Flat565> for Rgb565 {
     }
 }
 
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 const BLACK: StripPixel = {
     #[cfg(feature = "flat")]
     {
@@ -184,12 +188,12 @@ const BLACK: StripPixel = {
 
 /// The four cubes' corners, transformed, outcoded and snapped once per
 /// frame (8 per cube): what every strip's submission starts from.
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 type Vertices = [ProcessedVertex; 4 * 8];
 
 /// Processes the four cubes' vertices for a frame of `config` (once per
 /// frame: the result does not depend on the strip).
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
     // A frame with no storage is enough to run the vertex stage, which
     // does not depend on the mode (a frame refuses the clipless one).
@@ -208,7 +212,7 @@ fn process(config: Config, mvps: &[microraster::Mat4; 4], out: &mut Vertices) {
 /// Submits the four cubes to one strip (triangle ids as in
 /// `cubes::for_each_cube`); triangles wholly above or below the strip are
 /// skipped before setup.
-#[cfg(all(feature = "immediate", not(feature = "spot")))]
+#[cfg(all(feature = "immediate", not(baked)))]
 fn submit<D>(strip: &mut StripRenderer<'_, StripPixel, D>, vertices: &Vertices)
 where
     D: microraster::DepthBuffer + ?Sized,
@@ -253,7 +257,7 @@ fn ratio(n: u64, d: u64) -> (u64, u64) {
     (t / 10, t % 10)
 }
 
-#[cfg(not(feature = "spot"))]
+#[cfg(not(baked))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [StripPixel; STRIP_LEN] = [BLACK; STRIP_LEN];
