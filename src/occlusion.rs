@@ -580,8 +580,9 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
     /// Submits an object of `triangles` triangles bounded by `sphere`
     /// under `mvp`. It is skipped, counted in [`Stats::submitted`] and
     /// returning `Ok(false)` without calling `draw`, if the sphere lies
-    /// outside the frustum ([`Stats::culled_object`]), if its bound misses
-    /// the strip's pixels ([`Stats::outside_strip`]), or if the strip
+    /// outside the frustum ([`Stats::culled_object`]), if it lies wholly
+    /// above or below the strip or its bound misses the strip's pixels
+    /// ([`Stats::outside_strip`]), or if the strip
     /// hides it ([`Stats::culled_occlusion`]). Otherwise it calls `draw` with the
     /// renderer and returns `Ok(true)` (or `draw`'s error). `draw` must
     /// submit only triangles inside `sphere` under `mvp` (any submission
@@ -603,8 +604,9 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
 
     /// [`Occluder::submit_with`] with a box as well as (or instead of) the
     /// sphere: the box, tighter for most objects, gives the screen bound;
-    /// the sphere, if any, the frustum test. `draw` must submit only
-    /// triangles inside both.
+    /// the sphere, if any, the frustum test and the strip's (tested
+    /// first: it is cheaper than the box's projection). `draw` must
+    /// submit only triangles inside both.
     pub fn submit_bounded<R>(
         &mut self,
         sphere: Option<&BoundingSphere>,
@@ -658,6 +660,19 @@ impl<C: PixelFormat, W: DepthWord, const S: u32, const N: usize, F: FragmentShad
                 ..Stats::default()
             });
             return Test::Skipped;
+        }
+        // Wholly above or below the strip by the sphere (the test
+        // `submit_mesh` makes), before the box is projected: most parts
+        // of a frame lie outside any one strip, and the slab test costs
+        // a few dot products where the box costs eight corners.
+        if let (Some(s), Some((top, bottom))) = (sphere, self.renderer.stage.slab) {
+            if s.outside_slab(mvp, top, bottom) {
+                self.renderer.stats += skip(Stats {
+                    outside_strip: triangles,
+                    ..Stats::default()
+                });
+                return Test::Skipped;
+            }
         }
         let bound = match aabb {
             Some(b) => ScreenBound::of_box(b, mvp, &config),
