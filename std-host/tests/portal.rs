@@ -57,30 +57,36 @@ fn same(
     (count.reached, count.cells)
 }
 
+/// A house (its seed and rooms a side, 2 to 5) and a camera in one of its
+/// rooms, at least `CAMERA_MARGIN` from the walls, 0.5 to 2.1 high,
+/// looking in any direction (pitch within 0.4): seed, rooms, eye, target.
+fn house_camera_strategy() -> impl Strategy<Value = (u64, usize, [f32; 3], [f32; 3])> {
+    (
+        (any::<u64>(), 2usize..6, any::<u16>()),
+        (0.0f32..1.0, 0.0f32..1.0, 0.5f32..2.1),
+        (0.0f32..std::f32::consts::TAU, -0.4f32..0.4),
+    )
+        .prop_map(|((seed, n, room), (fx, fz, eye_y), (yaw, pitch))| {
+            let room = room as usize % (n * n);
+            let (i, j) = (room / n, room % n);
+            let inner = ROOM - WALL - 2.0 * CAMERA_MARGIN;
+            let x = i as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fx * inner;
+            let z = j as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fz * inner;
+            let eye = [x, eye_y, z];
+            (seed, n, eye, [x + yaw.cos(), eye_y + pitch, z + yaw.sin()])
+        })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
 
     #[test]
     fn skipped_rooms_change_no_pixel(
-        seed in any::<u64>(),
-        n in 2usize..6,
-        room in any::<u16>(),
-        fx in 0.0f32..1.0,
-        fz in 0.0f32..1.0,
-        yaw in 0.0f32..std::f32::consts::TAU,
-        pitch in -0.4f32..0.4,
-        eye_y in 0.5f32..2.1,
+        (seed, n, eye, target) in house_camera_strategy(),
         s8 in any::<bool>(),
         u32_depth in any::<bool>(),
     ) {
         let house = House::generate(n, seed);
-        let room = room as usize % (n * n);
-        let (i, j) = (room / n, room % n);
-        let inner = ROOM - WALL - 2.0 * CAMERA_MARGIN;
-        let x = i as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fx * inner;
-        let z = j as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fz * inner;
-        let eye = [x, eye_y, z];
-        let target = [x + yaw.cos(), eye_y + pitch, z + yaw.sin()];
         let depth = if u32_depth { DepthKind::U32 } else { DepthKind::U16 };
         same(&house, eye, target, (96, 72), if s8 { 8 } else { 4 }, depth);
     }
@@ -246,27 +252,13 @@ proptest! {
     /// strip, colour and depth, for any strip height.
     #[test]
     fn rooms_outside_a_strip_change_no_pixel(
-        seed in any::<u64>(),
-        n in 2usize..6,
-        room in any::<u16>(),
-        fx in 0.0f32..1.0,
-        fz in 0.0f32..1.0,
-        yaw in 0.0f32..std::f32::consts::TAU,
-        pitch in -0.4f32..0.4,
-        eye_y in 0.5f32..2.1,
+        (seed, n, eye, target) in house_camera_strategy(),
         rows in 1u32..40,
         s8 in any::<bool>(),
         u32_depth in any::<bool>(),
     ) {
         use microraster::portal::PixelRect;
         let house = House::generate(n, seed);
-        let room = room as usize % (n * n);
-        let (i, j) = (room / n, room % n);
-        let inner = ROOM - WALL - 2.0 * CAMERA_MARGIN;
-        let x = i as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fx * inner;
-        let z = j as f32 * ROOM + 0.5 * WALL + CAMERA_MARGIN + fz * inner;
-        let eye = [x, eye_y, z];
-        let target = [x + yaw.cos(), eye_y + pitch, z + yaw.sin()];
         let size = (96, 72);
         let vp = house.view_proj(eye, target, 60.0, size.0, size.1, false).unwrap();
         let mut rects = vec![PixelRect::EMPTY; n * n];

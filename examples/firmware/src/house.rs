@@ -28,7 +28,8 @@
 use crate::clock::Clock;
 use crate::display::HashDisplay;
 use crate::{
-    exit, ram_use, ratio, BOARD, CORE, HEIGHT, HOST_CHECKSUM, STRIP_LEN, STRIP_ROWS, WIDTH,
+    exit, finish, print_counts, ram_use, ratio, Counts, BOARD, CORE, HEIGHT, STRIP_LEN, STRIP_ROWS,
+    WIDTH,
 };
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
@@ -327,7 +328,6 @@ fn main() -> ! {
     let clears = instr(one_clear * strips);
     let geometry = instr(one_row * strips + walk).min(render - clears);
     let raster = render - clears - geometry;
-    let per_px = |n: u64| ratio(n, written);
     let total = baked::INDICES.len() as u64;
     let reached_rooms = n_first;
 
@@ -349,34 +349,20 @@ fn main() -> ! {
         strips,
         STRIP_ROWS,
     );
-    hprintln!("checksum {:#018x}", checksum.unwrap_or(0));
-    hprintln!("host     {:#018x}", HOST_CHECKSUM);
-    let (a, b) = ratio(cal_instr, cal_ticks);
-    hprintln!("instructions per SysTick tick {}.{}", a, b);
-    let (a, b) = per_px(frame);
-    hprintln!(
-        "instructions per frame {}; pixels written {}; per written pixel {}.{}",
-        frame,
-        written,
-        a,
-        b
+    print_counts(
+        checksum,
+        &Counts {
+            per_tick: (cal_instr, cal_ticks),
+            written,
+            frame,
+            shown,
+            render,
+            clears,
+            geometry,
+            raster,
+            strips: Some(strips),
+        },
     );
-    let (a, b) = per_px(shown);
-    hprintln!("  display push (checksum)  {} ({}.{}/px)", shown, a, b);
-    let (a, b) = per_px(render);
-    hprintln!("  render                   {} ({}.{}/px)", render, a, b);
-    let (a, b) = per_px(clears);
-    hprintln!("    strip clears           {} ({}.{}/px)", clears, a, b);
-    let (a, b) = per_px(geometry);
-    hprintln!(
-        "    geometry x {} strips   {} ({}.{}/px)",
-        strips,
-        geometry,
-        a,
-        b
-    );
-    let (a, b) = per_px(raster);
-    hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
     let (a, b) = ratio(skipped * 100, total * strips);
     hprintln!(
         "portals: {} of {} rooms reached, skipped before transform {} of {} triangles over the {} strips ({}.{} %), walk {} instructions a frame",
@@ -420,20 +406,5 @@ fn main() -> ! {
             exit(false)
         }
     }
-    match stack {
-        Some(s) => hprintln!(
-            "ram statics {} B + stack high-water {} B = {} B",
-            statics,
-            s,
-            statics + s
-        ),
-        None => hprintln!("ram statics {} B + stack: OVERFLOWED", statics),
-    }
-    let pass = checksum == Some(HOST_CHECKSUM) && stack.is_some();
-    if pass {
-        hprintln!("PASS: bit-identical to the host");
-    } else {
-        hprintln!("FAIL: the frame differs from the host's, or the stack overflowed");
-    }
-    exit(pass)
+    finish(checksum, statics, stack)
 }

@@ -23,9 +23,11 @@ use crate::clock::Clock;
 use crate::display::HashDisplay;
 #[cfg(feature = "clusters")]
 use crate::display::Saved;
+#[cfg(any(feature = "clusters", feature = "herd", feature = "cull-masks"))]
+use crate::ratio;
 use crate::spot_scene::{self, Draw, Model};
 use crate::{
-    exit, ram_use, ratio, BOARD, CORE, HEIGHT, HOST_CHECKSUM, STRIP_LEN, STRIP_ROWS, WIDTH,
+    exit, finish, print_counts, ram_use, Counts, BOARD, CORE, HEIGHT, STRIP_LEN, STRIP_ROWS, WIDTH,
 };
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
@@ -833,7 +835,6 @@ fn main() -> ! {
     let geometry =
         instr(m.one_row * strips + (m.strips_start - m.setup_start)).min(render - clears);
     let raster = render - clears - geometry;
-    let per_px = |n: u64| ratio(n, written);
 
     hprintln!(
         "microraster firmware: {} ({}), {}x{} Rgb565, depth u16, Spot ({} triangles, {}), {}, immediate, {} strips of {} rows",
@@ -847,34 +848,20 @@ fn main() -> ! {
         strips,
         STRIP_ROWS,
     );
-    hprintln!("checksum {:#018x}", checksum.unwrap_or(0));
-    hprintln!("host     {:#018x}", HOST_CHECKSUM);
-    let (a, b) = ratio(cal_instr, cal_ticks);
-    hprintln!("instructions per SysTick tick {}.{}", a, b);
-    let (a, b) = per_px(frame);
-    hprintln!(
-        "instructions per frame {}; pixels written {}; per written pixel {}.{}",
-        frame,
-        written,
-        a,
-        b
+    print_counts(
+        checksum,
+        &Counts {
+            per_tick: (cal_instr, cal_ticks),
+            written,
+            frame,
+            shown,
+            render,
+            clears,
+            geometry,
+            raster,
+            strips: Some(strips),
+        },
     );
-    let (a, b) = per_px(shown);
-    hprintln!("  display push (checksum)  {} ({}.{}/px)", shown, a, b);
-    let (a, b) = per_px(render);
-    hprintln!("  render                   {} ({}.{}/px)", render, a, b);
-    let (a, b) = per_px(clears);
-    hprintln!("    strip clears           {} ({}.{}/px)", clears, a, b);
-    let (a, b) = per_px(geometry);
-    hprintln!(
-        "    geometry x {} strips   {} ({}.{}/px)",
-        strips,
-        geometry,
-        a,
-        b
-    );
-    let (a, b) = per_px(raster);
-    hprintln!("    rasterization          {} ({}.{}/px)", raster, a, b);
     #[cfg(feature = "clusters")]
     {
         let c = &m.clusters;
@@ -983,21 +970,5 @@ fn main() -> ! {
             instr(c.build)
         );
     }
-    match stack {
-        Some(s) => hprintln!(
-            "ram statics {} B + stack high-water {} B = {} B",
-            statics,
-            s,
-            statics + s
-        ),
-        None => hprintln!("ram statics {} B + stack: OVERFLOWED", statics),
-    }
-
-    let pass = checksum == Some(HOST_CHECKSUM) && stack.is_some();
-    if pass {
-        hprintln!("PASS: bit-identical to the host");
-    } else {
-        hprintln!("FAIL: the frame differs from the host's, or the stack overflowed");
-    }
-    exit(pass)
+    finish(checksum, statics, stack)
 }
