@@ -409,18 +409,24 @@ impl House {
     /// Rust source (`include!`, `no_std`, plain arrays in flash) of the
     /// house seen from [`house_camera`]`(camera, n)` in a frame of
     /// `width x height` (60° vertical field of view): the world-to-clip
-    /// matrix, the eye's cell, every object's vertices (each object's
-    /// equal positions shared, which draws the same pixels), triangles,
-    /// colours (one a triangle), room and bounding sphere, and the cells
-    /// and portals of [`PortalGraph`].
+    /// matrix and the eye's cell, the same for [`FIRMWARE_SWEEP`] cameras
+    /// from 0, every object's vertices (a flat object's equal positions
+    /// shared, which draws the same pixels), triangles, colours (per
+    /// triangle, or per vertex for the balls), room and bounding sphere,
+    /// and the cells and portals of [`PortalGraph`].
     pub fn bake_source(&self, camera: usize, width: u32, height: u32) -> Result<String, String> {
         use crate::bake::f32_literal as f;
         use std::fmt::Write;
-        let (eye, target) = house_camera(camera, self.n);
-        let start = self
-            .room_of(eye)
-            .ok_or_else(|| format!("camera {camera} is in no room"))?;
-        let vp = self.view_proj(eye, target, 60.0, width, height, false)?;
+        // Camera k: its eye, target, eye's cell and matrix.
+        let camera_k = |k: usize| -> Result<_, String> {
+            let (eye, target) = house_camera(k, self.n);
+            let start = self
+                .room_of(eye)
+                .ok_or_else(|| format!("camera {k} is in no room"))?;
+            let vp = self.view_proj(eye, target, 60.0, width, height, false)?;
+            Ok((eye, target, start, vp))
+        };
+        let (eye, target, start, vp) = camera_k(camera)?;
         let config = Config::new(width, height);
         let mut rects = vec![PixelRect::EMPTY; self.cells.len()];
         let count = self
@@ -515,11 +521,7 @@ impl House {
         let cols = mat(&vp);
         let mut sweep = String::new();
         for k in 0..FIRMWARE_SWEEP {
-            let (eye, target) = house_camera(k, self.n);
-            let start = self
-                .room_of(eye)
-                .ok_or_else(|| format!("camera {k} is in no room"))?;
-            let vp = self.view_proj(eye, target, 60.0, width, height, false)?;
+            let (_, _, start, vp) = camera_k(k)?;
             let _ = writeln!(
                 sweep,
                 "    HouseCamera {{ view_proj: {}, start: {start} }},",
@@ -1014,7 +1016,9 @@ pub fn markdown(r: &PortalRow, n: usize, cameras: usize, size: (u32, u32)) -> St
 /// `microraster bake-house`: writes `house.rs` into `args.out` (nothing
 /// if the bake fails) and prints what it holds.
 pub fn bake_run(args: &crate::cli::BakeHouseArgs) -> Result<(), String> {
-    // The firmware keeps a bit a room in a `u64`.
+    // The firmware keeps 12 bytes a room on its stack while it walks (the
+    // rectangles, then the strips' bits): at 8x8 that leaves 684 B of the
+    // 24 KB, and 8x8 is the `house` scene's size.
     if !(1..=8).contains(&args.rooms) {
         return Err(format!("--rooms must be 1 to 8, got {}", args.rooms));
     }

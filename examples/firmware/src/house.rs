@@ -26,17 +26,15 @@
 //! times the strips, and the walk.
 
 use crate::clock::Clock;
-use crate::display::HashDisplay;
+use crate::display::{push, HashDisplay};
 use crate::{
     exit, finish, print_counts, ram_use, ratio, Counts, BOARD, CORE, HEIGHT, STRIP_LEN, STRIP_ROWS,
     WIDTH,
 };
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::primitives::Rectangle;
 use microraster::pixelcolor::{Rgb565, RgbColor};
-use microraster::{Config, Mesh, MeshColors, StripRenderer, StripSink, Submit};
+use microraster::{Config, Mesh, MeshColors, StripRenderer, Submit};
 
 /// The baked house (`microraster bake-house`, see docs/culling.md).
 #[allow(dead_code)]
@@ -147,13 +145,6 @@ fn submit<S: Submit<8, 3>>(
             .map_err(|_| "submit")?;
     }
     Ok(skipped)
-}
-
-/// Pushes rows `y0..y1` to the display as one strip.
-#[inline(never)]
-fn push(display: &mut HashDisplay, y0: u32, y1: u32, rows: &[Rgb565]) -> Result<(), &'static str> {
-    let area = Rectangle::new(Point::new(0, y0 as i32), Size::new(WIDTH, y1 - y0));
-    display.push_strip(&area, rows).map_err(|_| "display")
 }
 
 /// The frame from `camera`: the walk (with `culled`; else every room in

@@ -20,9 +20,9 @@
 //! and rasterization (with shading) the rest of the render.
 
 use crate::clock::Clock;
-use crate::display::HashDisplay;
 #[cfg(feature = "clusters")]
 use crate::display::Saved;
+use crate::display::{push, HashDisplay};
 #[cfg(any(feature = "clusters", feature = "herd", feature = "cull-masks"))]
 use crate::ratio;
 use crate::spot_scene::{self, Draw, Model};
@@ -31,14 +31,11 @@ use crate::{
 };
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use embedded_graphics_core::geometry::{Point, Size};
-use embedded_graphics_core::primitives::Rectangle;
 #[cfg(feature = "clusters")]
 use microraster::cull::{Eye, Visit};
 use microraster::pixelcolor::{Rgb565, RgbColor};
 #[cfg(feature = "cull-masks")]
 use microraster::NormalClasses;
-use microraster::StripSink;
 use microraster::{Attributes, Config, FragmentShader, Mat4, Mesh, StripRenderer, Submit};
 #[cfg(feature = "clusters")]
 use microraster::{ClusterCull, ClusterSet, ClusterTest};
@@ -736,15 +733,6 @@ fn triangles(a: usize, b: usize) -> u64 {
             .map(|k| u64::from(k.triangles[1] - k.triangles[0]))
             .sum()
     })
-}
-
-/// Pushes rows `y0..y1` to the display as one strip (the buffer itself,
-/// as `StripDrawer` does). Out of line, so that the push compiles (and
-/// counts) the same whatever the shading around it.
-#[inline(never)]
-fn push(display: &mut HashDisplay, y0: u32, y1: u32, rows: &[Rgb565]) -> Result<(), &'static str> {
-    let area = Rectangle::new(Point::new(0, y0 as i32), Size::new(WIDTH, y1 - y0));
-    display.push_strip(&area, rows).map_err(|_| "display")
 }
 
 #[entry]
