@@ -115,10 +115,17 @@ trait EdgeInt:
     /// `self` as `R` (from `i32` where `Self` is: the same value, rounded
     /// the same way, without `i64`'s library call on 32-bit cores).
     fn real<R: Real>(self) -> R;
-    /// `a b - c d + bias`, which the caller has proved to fit (each input
-    /// fits too): in `Self`'s wrapping arithmetic, exact because the
-    /// result is in range.
-    fn edge_value(a: i64, b: i64, c: i64, d: i64, bias: i64) -> Self;
+    /// `a b - c d + bias`, which the caller has proved to fit: in
+    /// `Self`'s wrapping arithmetic, exact because the result is in range.
+    fn edge_value(a: Self, b: Self, c: Self, d: Self, bias: i32) -> Self;
+    /// All ones if `self < 0`, else 0.
+    fn sign_mask(self) -> Self;
+    /// `a - b`, which the caller has proved to fit (for `i32`: coordinates
+    /// of one triangle, see [`EDGE32_SPAN`]), without `i64` arithmetic.
+    fn diff(a: i32, b: i32) -> Self;
+    /// `p - a` for a pixel centre `p` of the triangle's box (which fits
+    /// `i32` wherever `Self` is `i32`), as `diff`.
+    fn diff_wide(p: i64, a: i32) -> Self;
 }
 
 macro_rules! impl_edge_int {
@@ -134,6 +141,20 @@ macro_rules! impl_edge_int {
             #[inline(always)]
             fn widen(self) -> i64 {
                 self as i64
+            }
+            #[inline(always)]
+            fn sign_mask(self) -> $t {
+                self >> (<$t>::BITS - 1)
+            }
+            #[inline(always)]
+            fn diff(a: i32, b: i32) -> $t {
+                <$t>::narrow(a as i64 - b as i64);
+                (a as $t).wrapping_sub(b as $t)
+            }
+            #[inline(always)]
+            fn diff_wide(p: i64, a: i32) -> $t {
+                <$t>::narrow(p - a as i64);
+                (p as $t).wrapping_sub(a as $t)
             }
             #[inline(always)]
             fn from_usize(v: usize) -> $t {
@@ -152,12 +173,11 @@ macro_rules! impl_edge_int {
                 R::$from(self)
             }
             #[inline(always)]
-            fn edge_value(a: i64, b: i64, c: i64, d: i64, bias: i64) -> $t {
-                let [a, b, c, d, bias] = [a, b, c, d, bias].map(<$t>::narrow);
+            fn edge_value(a: $t, b: $t, c: $t, d: $t, bias: i32) -> $t {
                 let e = a
                     .wrapping_mul(b)
                     .wrapping_sub(c.wrapping_mul(d))
-                    .wrapping_add(bias);
+                    .wrapping_add(bias as $t);
                 debug_assert_eq!(
                     e as i64,
                     a as i64 * b as i64 - c as i64 * d as i64 + bias as i64
@@ -199,8 +219,11 @@ fn fits_i32<const N: usize>(t: &SetupTriangle<N>) -> bool {
     if cfg!(feature = "no-i32-edges") {
         return false;
     }
-    let span = |v: [i32; 3]| v[0].max(v[1]).max(v[2]) as i64 - v[0].min(v[1]).min(v[2]) as i64;
-    span(t.x) <= EDGE32_SPAN && span(t.y) <= EDGE32_SPAN
+    // max - min is in [0, 2^32): exact as a wrapping `u32` difference.
+    let span = |v: [i32; 3]| {
+        (v[0].max(v[1]).max(v[2]) as u32).wrapping_sub(v[0].min(v[1]).min(v[2]) as u32)
+    };
+    span(t.x) <= EDGE32_SPAN as u32 && span(t.y) <= EDGE32_SPAN as u32
 }
 
 /// One edge function, set up for stepping in whole pixels.
@@ -222,17 +245,20 @@ impl<T: EdgeInt> Edge<T> {
     /// without `i64` multiplications (a library call on the Cortex-M0: 3 %
     /// of its four-cubes rasterization).
     fn new<const S: u32>(xa: i32, ya: i32, xb: i32, yb: i32, px: i64, py: i64) -> Edge<T> {
-        let dx = xb as i64 - xa as i64;
-        let dy = yb as i64 - ya as i64;
+        // In `T`: the differences fit, and for `i32` so do the value and
+        // the steps (`EDGE32_SPAN`), so `i32` needs no `i64` arithmetic.
+        let dx = T::diff(xb, xa);
+        let dy = T::diff(yb, ya);
         // Window y points down; with positive area the interior is on the
         // side where E > 0. Top edge: horizontal with the interior below
         // (dx > 0); left edge: going up (dy < 0).
-        let top_left = dy < 0 || (dy == 0 && dx > 0);
+        let top_left = dy < T::ZERO || (dy == T::ZERO && dx > T::ZERO);
         let bias = if top_left { 0 } else { -1 };
+        let unit = T::from_usize(1 << S);
         Edge {
-            row: T::edge_value(dx, py - ya as i64, dy, px - xa as i64, bias as i64),
-            step_x: T::narrow(-dy << S),
-            step_y: T::narrow(dx << S),
+            row: T::edge_value(dx, T::diff_wide(py, ya), dy, T::diff_wide(px, xa), bias),
+            step_x: -dy * unit,
+            step_y: dx * unit,
             bias,
         }
     }
@@ -674,9 +700,26 @@ struct Acc<R, const N: usize> {
     w: f32,
 }
 
-impl<R: Real, const N: usize> Shader<R, N> {
-    #[cfg_attr(target_pointer_width = "32", inline(always))]
-    fn new<C: PixelFormat, D: DepthBuffer + ?Sized, T: EdgeInt>(
+/// A triangle's depth plane alone: what the flat rows of a `Z32.0`
+/// buffer need ([`flat_rows_in_range`]), without the rest of a
+/// [`Shader`]. The same values as the shader's: [`Shader::new`] takes its
+/// depth from here, and [`DepthPlane::z_at`] is [`Shader::z_at`]'s sum.
+#[derive(Clone, Copy)]
+struct DepthPlane<R> {
+    z0: R,
+    k1: R,
+    k2: R,
+    dz: R,
+    /// The step in `Z32.F` (`F` = [`DepthBuffer::FRAC`]), rounded.
+    dz_fixed: i64,
+    /// Edges 1 and 2's biases (the unbiased value is the biased one less
+    /// its bias).
+    bias: [i32; 2],
+}
+
+impl<R: Real> DepthPlane<R> {
+    #[inline(always)]
+    fn new<const N: usize, D: DepthBuffer + ?Sized, T: EdgeInt>(
         t: &SetupTriangle<N>,
         edges: &[Edge<T>; 3],
     ) -> Self {
@@ -690,6 +733,32 @@ impl<R: Real, const N: usize> Shader<R, N> {
             k2 = z_difference::<R>(t.z[0], t.z[2]) * inv_area;
             dz = k1 * edges[1].step_x.real::<R>() + k2 * edges[2].step_x.real::<R>();
         }
+        DepthPlane {
+            z0: R::from_u32(t.z[0]),
+            k1,
+            k2,
+            dz,
+            dz_fixed: dz.to_fixed(D::FRAC),
+            bias: [edges[1].bias, edges[2].bias],
+        }
+    }
+
+    /// Depth at the pixel whose biased edge values 1 and 2 are `e1`, `e2`.
+    #[inline(always)]
+    fn z_at<T: EdgeInt>(&self, e1: T, e2: T) -> R {
+        self.z0
+            + self.k1 * e1.unbiased::<R>(self.bias[0])
+            + self.k2 * e2.unbiased::<R>(self.bias[1])
+    }
+}
+
+impl<R: Real, const N: usize> Shader<R, N> {
+    #[cfg_attr(target_pointer_width = "32", inline(always))]
+    fn new<C: PixelFormat, D: DepthBuffer + ?Sized, T: EdgeInt>(
+        t: &SetupTriangle<N>,
+        edges: &[Edge<T>; 3],
+    ) -> Self {
+        let plane = DepthPlane::<R>::new::<N, D, T>(t, edges);
         let smooth = C::SHADED && t.smooth;
         let mut dv = [0.0f32; N];
         let mut dw = 0.0f32;
@@ -707,15 +776,28 @@ impl<R: Real, const N: usize> Shader<R, N> {
             dw = st[0] * t.inv_w[0] + st[1] * t.inv_w[1] + st[2] * t.inv_w[2];
         }
         Shader {
-            z0: R::from_u32(t.z[0]),
-            k1,
-            k2,
-            dz,
-            dz_fixed: dz.to_fixed(D::FRAC),
+            z0: plane.z0,
+            k1: plane.k1,
+            k2: plane.k2,
+            dz: plane.dz,
+            dz_fixed: plane.dz_fixed,
             bias: [edges[0].bias, edges[1].bias, edges[2].bias],
             dv,
             dw,
             smooth,
+        }
+    }
+
+    /// The depth plane it holds.
+    #[cfg(not(target_pointer_width = "32"))]
+    fn plane(&self) -> DepthPlane<R> {
+        DepthPlane {
+            z0: self.z0,
+            k1: self.k1,
+            k2: self.k2,
+            dz: self.dz,
+            dz_fixed: self.dz_fixed,
+            bias: [self.bias[1], self.bias[2]],
         }
     }
 
@@ -1214,7 +1296,6 @@ fn flat_rows<
     px: C,
 ) -> u32 {
     let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
-    let shader = &Shader::<R, N>::new::<C, D, T>(t, &edges);
     let rows = row_last - row_first + 1;
     let max_n = (t.max_x - t.min_x) as usize;
     let z = t.z;
@@ -1228,7 +1309,14 @@ fn flat_rows<
             DepthFunc::GreaterEqual => Some(cmp::GREATER_EQUAL),
             _ => None,
         };
-        let args = (edges, shader, rows, base, max_n);
+        // (The depth plane alone: the rest of a `Shader` is not needed.)
+        let args = (
+            edges,
+            &DepthPlane::new::<N, D, T>(t, &edges),
+            rows,
+            base,
+            max_n,
+        );
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
@@ -1240,6 +1328,7 @@ fn flat_rows<
             None => {}
         }
     }
+    let shader = &Shader::<R, N>::new::<C, D, T>(t, &edges);
     let mut written = 0u32;
     let mut spans = RowSpans::new(&edges, max_n);
     for _ in 0..rows {
@@ -1298,7 +1387,7 @@ fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: R
             DepthFunc::GreaterEqual => Some(cmp::GREATER_EQUAL),
             _ => None,
         };
-        let args = (edges, shader, rows, base, max_n);
+        let args = (edges, &shader.plane(), rows, base, max_n);
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
@@ -1383,35 +1472,155 @@ fn flat_rows_in_range<
     T: EdgeInt,
     const LESS: bool,
 >(
-    (mut edges, shader, rows, mut base, max_n): ([Edge<T>; 3], &Shader<R, N>, u32, usize, usize),
+    (mut edges, plane, rows, mut base, max_n): ([Edge<T>; 3], &DepthPlane<R>, u32, usize, usize),
     strip: &mut Strip<'_, C, D>,
     cmp: u8,
     px: C,
 ) -> u32 {
     let cmp = if LESS { cmp::LESS } else { cmp };
     let mut written = 0u32;
-    let mut spans = RowSpans::new(&edges, max_n);
-    for _ in 0..rows {
-        if let Some((lo, hi)) = spans.span(&edges) {
-            let z0 = shader.z_at::<D, T>(edges[1].at(lo), edges[2].at(lo));
-            let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
-            written += strip.depth.flat_span_in_range(
-                strip.color,
-                base + lo,
-                hi - lo + 1,
-                z0.round_in_range(),
-                shader.dz_fixed,
-                cmp,
-                px,
-            );
+    if DIVIDE_IS_SLOW {
+        let mut spans = RowSpans::new(&edges, max_n);
+        for _ in 0..rows {
+            if let Some((lo, hi)) = spans.span(&edges) {
+                let z0 = plane.z_at(edges[1].at(lo), edges[2].at(lo));
+                let (lo, hi) = (lo.widen() as usize, hi.widen() as usize);
+                written += strip.depth.flat_span_in_range(
+                    strip.color,
+                    base + lo,
+                    hi - lo + 1,
+                    z0.round_in_range(),
+                    plane.dz_fixed,
+                    cmp,
+                    px,
+                );
+            }
+            spans.next();
+            for edge in edges.iter_mut() {
+                edge.row += edge.step_y;
+            }
+            base += strip.width;
         }
-        spans.next();
-        for edge in edges.iter_mut() {
-            edge.row += edge.step_y;
+        return written;
+    }
+    // A horizontal edge covers whole rows or none: the rows it covers are
+    // a run, and cut to it, the edge bounds no span (a left edge of step
+    // 1, below).
+    let (mut first, mut end) = (0i64, rows as i64);
+    for e in edges.iter() {
+        if e.step_x == T::ZERO {
+            let (e0, sy) = (e.row.widen(), e.step_y.widen());
+            // Rows r with e0 + r sy >= 0.
+            if sy > 0 {
+                if e0 < 0 {
+                    first = first.max((-e0 + sy - 1) / sy);
+                }
+            } else if sy < 0 {
+                end = end.min(if e0 < 0 { 0 } else { e0 / -sy + 1 });
+            } else if e0 < 0 {
+                end = 0;
+            }
         }
-        base += strip.width;
+    }
+    if first >= end {
+        return 0;
+    }
+    if first > 0 {
+        for e in edges.iter_mut() {
+            e.row = T::narrow(e.row.widen() + first * e.step_y.widen());
+        }
+        base += first as usize * strip.width;
+    }
+    let rows = (end - first) as usize;
+    // Each edge's side, a bit a left edge (horizontal ones count as left);
+    // a triangle has one of each at least, so six patterns.
+    let sides = edges
+        .iter()
+        .enumerate()
+        .fold(0u8, |b, (k, e)| b | ((e.step_x >= T::ZERO) as u8) << k);
+    let max_n = T::from_usize(max_n);
+    // (A `heapless::Vec`: filled, not cleared first.)
+    let mut batch = heapless::Vec::<[u32; 3], ROW_BATCH>::new();
+    let mut left = rows;
+    while left > 0 {
+        let n = left.min(ROW_BATCH);
+        let out = (&mut batch, n, base, strip.width);
+        match sides {
+            1 => batch_spans::<R, T, 1>(&mut edges, plane, max_n, out),
+            2 => batch_spans::<R, T, 2>(&mut edges, plane, max_n, out),
+            3 => batch_spans::<R, T, 3>(&mut edges, plane, max_n, out),
+            4 => batch_spans::<R, T, 4>(&mut edges, plane, max_n, out),
+            5 => batch_spans::<R, T, 5>(&mut edges, plane, max_n, out),
+            _ => batch_spans::<R, T, 6>(&mut edges, plane, max_n, out),
+        }
+        written += strip
+            .depth
+            .flat_spans_in_range(strip.color, &batch, plane.dz_fixed, cmp, px);
+        base += n * strip.width;
+        left -= n;
     }
     written
+}
+
+/// Rows whose spans [`flat_rows_in_range`] finds before it draws them:
+/// each loop then keeps its own values in registers (one loop doing both
+/// spilled a third of them every row).
+const ROW_BATCH: usize = 16;
+
+/// The spans of the next `n` rows, the first starting at `base` in the
+/// buffers, the rest `width` apart: `[start, length, Z32 start]` each
+/// (none for an empty row; a strip's buffers, whose index fits `u32`,
+/// hold every start), for edges whose sides are `SIDES` (bit `k`:
+/// edge `k` bounds spans on the left). The same spans as three
+/// [`Edge::clip_span`]s, without a branch on a side: a left edge of step
+/// `d > 0` covers `n >= ceil(-E / d)`, which is `(d - 1 - E) / d`
+/// truncated when `E <= 0` and at most 0 (no bound) otherwise; a right
+/// edge of step `-d` covers `n <= floor(E / d)`, which is `E / d` when `E
+/// >= 0`, and for `E < 0` nothing: or-ing in the sign (`E >> 31`, all
+/// ones) makes the bound -1. A horizontal edge, whose rows are cut to
+/// where `E >= 0`, is a left edge of step 1: `-E <= 0`, no bound. The
+/// operands stay in the ranges [`EDGE32_SPAN`] proves.
+#[inline(never)]
+fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
+    edges: &mut [Edge<T>; 3],
+    plane: &DepthPlane<R>,
+    max_n: T,
+    (out, n, base, width): (&mut heapless::Vec<[u32; 3], ROW_BATCH>, usize, usize, usize),
+) {
+    let d: [T; 3] = core::array::from_fn(|k| {
+        let a = edges[k].step_x;
+        if SIDES & 1 << k != 0 {
+            a.max(T::ONE)
+        } else {
+            (-a).max(T::ONE)
+        }
+    });
+    let mut e = [edges[0].row, edges[1].row, edges[2].row];
+    out.clear();
+    let mut row = base;
+    for _ in 0..n {
+        let (mut lo, mut hi) = (T::ZERO, max_n);
+        for k in 0..3 {
+            if SIDES & 1 << k != 0 {
+                lo = lo.max((d[k] - T::ONE - e[k]) / d[k]);
+            } else {
+                hi = hi.min(e[k].sign_mask() | (e[k] / d[k]));
+            }
+        }
+        if lo <= hi {
+            let z0 = plane.z_at(e[1] + edges[1].step_x * lo, e[2] + edges[2].step_x * lo);
+            let start = row.wrapping_add(lo.widen() as usize) as u32;
+            // (`n <= ROW_BATCH`: every push fits.)
+            let _ = out.push([start, (hi - lo).widen() as u32 + 1, z0.round_in_range()]);
+        }
+        row = row.wrapping_add(width);
+        for k in 0..3 {
+            e[k] += edges[k].step_y;
+        }
+    }
+    for k in 0..3 {
+        edges[k].row = e[k];
+    }
 }
 
 #[cfg(test)]

@@ -167,12 +167,15 @@ fn clip_case<const S: u32>() -> impl Strategy<Value = (u32, u32, [Vec4; 3])> {
 proptest! {
     #![proptest_config(cases(2048))]
 
-    /// Vertices on the 1/256 grid: coverage equals the reference exactly.
+    /// Vertices on the 1/256 grid: coverage equals the reference exactly,
+    /// drawn alone and through `u16` and `u32` depth buffers (the `u16`
+    /// one by the batched flat rows, `flat_rows_in_range`).
     #[test]
     fn coverage_matches_reference_on_grid_s8((w, h, v) in grid_case(8)) {
         let pos = grid_to_clip(v, 8, w, h);
         prop_assert_eq!(snap_tri::<8>(&pos, w, h), Some(v), "construction must be exact");
         check_coverage::<8>(config_nocull(w, h), pos)?;
+        check_depth_coverage::<8>(config_nocull(w, h), pos)?;
     }
 
     /// Vertices on the 1/16 grid: coverage equals the reference exactly.
@@ -181,6 +184,7 @@ proptest! {
         let pos = grid_to_clip(v, 4, w, h);
         prop_assert_eq!(snap_tri::<4>(&pos, w, h), Some(v), "construction must be exact");
         check_coverage::<4>(config_nocull(w, h), pos)?;
+        check_depth_coverage::<4>(config_nocull(w, h), pos)?;
     }
 
     /// Random f32 clip coordinates (any w > 0, no clipping needed): the
@@ -188,12 +192,14 @@ proptest! {
     #[test]
     fn coverage_matches_reference_off_grid_s8((w, h, pos) in clip_case::<8>()) {
         check_coverage::<8>(config_nocull(w, h), pos)?;
+        check_depth_coverage::<8>(config_nocull(w, h), pos)?;
     }
 
     /// As above at 4 subpixel bits.
     #[test]
     fn coverage_matches_reference_off_grid_s4((w, h, pos) in clip_case::<4>()) {
         check_coverage::<4>(config_nocull(w, h), pos)?;
+        check_depth_coverage::<4>(config_nocull(w, h), pos)?;
     }
 
     /// With culling, a triangle is drawn (exactly as the reference) iff its
@@ -1142,8 +1148,23 @@ fn check_depth_coverage<const S: u32>(config: Config, pos: [Vec4; 3]) -> Result<
             .expect("valid rows");
         (ids16, ids32)
     });
+    // `Greater` into a buffer cleared to 0: the other copy of the `u16`
+    // flat rows (`LessEqual`, `Greater` and `GreaterEqual` share it).
+    let greater = Config {
+        depth_func: DepthFunc::Greater,
+        ..config
+    };
+    let ids16_greater = with_frame::<S, _>(greater, &[pos], |frame| {
+        let mut ids = vec![TriangleId(0); n];
+        let mut z16 = vec![0u16; n];
+        frame
+            .render_rows(0, config.height, &mut ids[..], &mut z16[..])
+            .expect("valid rows");
+        ids
+    });
     let covered = |ids: Vec<TriangleId>| ids.into_iter().map(|t| t.0 != 0).collect::<Vec<_>>();
     prop_assert_eq!(covered(ids16), plain.clone(), "u16 depth");
+    prop_assert_eq!(covered(ids16_greater), plain.clone(), "u16 depth, Greater");
     prop_assert_eq!(covered(ids32), plain, "u32 depth");
     Ok(())
 }
@@ -1348,5 +1369,45 @@ proptest! {
         }
         let (z16, z32, both) = depth_pair::<4>(w, h, pos);
         check_depth_pair(&z16, &z32, &both)?;
+    }
+}
+
+/// Hard case: horizontal edges exactly through pixel centres, above and
+/// below (a top edge's row is drawn, a bottom edge's is not), with the
+/// third vertex on either side and at 8 and 4 subpixel bits: coverage,
+/// also through the `u16` depth buffer's batched flat rows (which cut a
+/// horizontal edge's rows before its spans), equals the reference.
+#[test]
+fn horizontal_edges_through_pixel_centres_match_the_reference() {
+    let (w, h) = (16, 16);
+    for s in [8u32, 4] {
+        let one = 1i64 << s;
+        let half = one / 2;
+        let c = |k: i64| k * one + half;
+        for (flat_y, apex_y) in [
+            (c(3), c(11)),
+            (c(11), c(3)),
+            (c(5), c(5) + 3),
+            (c(9), c(9) - 3),
+        ] {
+            for apex_x in [c(0), c(4), c(7) + 1, c(13)] {
+                for (x0, x1) in [(c(2), c(12)), (c(4) + 5, c(9) - 7)] {
+                    let v = [(x0, flat_y), (x1, flat_y), (apex_x, apex_y)];
+                    let pos = grid_to_clip(v, s, w, h);
+                    let run = || -> Result<(), TestCaseError> {
+                        if s == 8 {
+                            check_coverage::<8>(config_nocull(w, h), pos)?;
+                            check_depth_coverage::<8>(config_nocull(w, h), pos)
+                        } else {
+                            check_coverage::<4>(config_nocull(w, h), pos)?;
+                            check_depth_coverage::<4>(config_nocull(w, h), pos)
+                        }
+                    };
+                    if let Err(e) = run() {
+                        panic!("S={s} {v:?}: {e}");
+                    }
+                }
+            }
+        }
     }
 }
