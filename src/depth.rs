@@ -191,10 +191,11 @@ pub trait DepthBuffer {
     }
 
     /// [`flat_span_in_range`](DepthBuffer::flat_span_in_range) for a
-    /// batch of spans, each `[start, length, Z32 start]`. Buffers
-    /// override it with one loop over the spans (a call a span, and the
-    /// arguments it takes, were a third of a small span's instructions on
-    /// the Cortex-M4F).
+    /// batch of spans, each `[start, length, Z32 start]`; returns the
+    /// pixels of the spans it did not write (the caller, which made the
+    /// spans, has their sum). Buffers override it with one loop over the
+    /// spans (a call a span, and the arguments it takes, were a third of
+    /// a small span's instructions on the Cortex-M4F).
     #[doc(hidden)]
     #[inline(always)]
     fn flat_spans_in_range<C: Copy>(
@@ -205,12 +206,12 @@ pub trait DepthBuffer {
         cmp: u8,
         px: C,
     ) -> u32 {
-        let mut written = 0;
+        let mut missed = 0;
         for &[start, len, z0] in spans {
-            written +=
-                self.flat_span_in_range(color, start as usize, len as usize, z0, dz, cmp, px);
+            missed +=
+                len - self.flat_span_in_range(color, start as usize, len as usize, z0, dz, cmp, px);
         }
-        written
+        missed
     }
 
     /// Sets values `start..start + len` (those held) to the depth `z32`
@@ -353,15 +354,16 @@ fn spans_z32<W: DepthWord, C: Copy, const CMP: u8>(
     dz: u32,
     px: C,
 ) -> u32 {
-    let (mut drawn, mut failed) = (0u32, 0u32);
+    let mut missed = 0u32;
     for &[start, len, z0] in spans {
         let (start, end) = (start as usize, start as usize + len as usize);
-        if let (Some(c), Some(d)) = (c.get_mut(start..end), d.get_mut(start..end)) {
-            z32_misses::<W, C, CMP>(c, d, z0, dz, px, &mut failed);
-            drawn += len;
+        match (c.get_mut(start..end), d.get_mut(start..end)) {
+            (Some(c), Some(d)) => z32_misses::<W, C, CMP>(c, d, z0, dz, px, &mut missed),
+            // (Never: the spans lie in the buffers.)
+            _ => missed += len,
         }
     }
-    drawn - failed
+    missed
 }
 
 /// The span of [`DepthBuffer::untested_span`], where every pixel passes:
@@ -870,12 +872,12 @@ impl<W: DepthWord> DepthBuffer for [W] {
     ) -> u32 {
         debug_assert!(W::FRAC == 0);
         if cfg!(target_pointer_width = "64") {
-            let mut written = 0;
+            let mut missed = 0;
             for &[start, len, z0] in spans {
-                written +=
-                    self.flat_span_in_range(color, start as usize, len as usize, z0, dz, cmp, px);
+                let (at, n) = (start as usize, len as usize);
+                missed += len - self.flat_span_in_range(color, at, n, z0, dz, cmp, px);
             }
-            return written;
+            return missed;
         }
         let rows = (color, self, spans);
         match cmp {

@@ -243,8 +243,8 @@ fn clear_rect_prefix<'a, W: DepthWord, P: Copy>(
     let z = W::from_z32(z32);
     let (n, first, stride, run) = rect_runs(width, rect);
     let end = depth.len().max(color.len());
-    for k in 0..n {
-        let a = first.saturating_add(k.saturating_mul(stride));
+    let mut a = first;
+    for _ in 0..n {
         if a >= end {
             break;
         }
@@ -259,6 +259,7 @@ fn clear_rect_prefix<'a, W: DepthWord, P: Copy>(
                 color[a.min(cl)..b.min(cl)].fill(background);
             }
         }
+        a = a.saturating_add(stride);
     }
     depth.get_mut(..len)
 }

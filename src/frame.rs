@@ -494,6 +494,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             depth_write: c.depth_write,
             touched: Touched::NONE,
             track: matches!(keep, Keep::Touched),
+            spans: [[0; 3]; crate::raster::ROW_BATCH],
             #[cfg(feature = "lazy-clear")]
             lazy: match keep {
                 Keep::Lazy(l) => Some(crate::raster::lazy::Lazy {

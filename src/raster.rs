@@ -215,7 +215,7 @@ pub const EDGE32_SPAN: i64 = 45_000;
 /// the `i32` path saves (`microraster report speed-vs-error`, the firmware's
 /// counts); the pixels are the same.
 #[inline]
-fn fits_i32<const N: usize>(t: &SetupTriangle<N>) -> bool {
+pub(crate) fn fits_i32(x: [i32; 3], y: [i32; 3]) -> bool {
     if cfg!(feature = "no-i32-edges") {
         return false;
     }
@@ -223,7 +223,7 @@ fn fits_i32<const N: usize>(t: &SetupTriangle<N>) -> bool {
     let span = |v: [i32; 3]| {
         (v[0].max(v[1]).max(v[2]) as u32).wrapping_sub(v[0].min(v[1]).min(v[2]) as u32)
     };
-    span(t.x) <= EDGE32_SPAN as u32 && span(t.y) <= EDGE32_SPAN as u32
+    span(x) <= EDGE32_SPAN as u32 && span(y) <= EDGE32_SPAN as u32
 }
 
 /// One edge function, set up for stepping in whole pixels.
@@ -490,6 +490,9 @@ pub(crate) struct Strip<'b, C, D: ?Sized> {
     /// A deferred clear: the buffers hold anything outside the hull.
     #[cfg(feature = "lazy-clear")]
     pub lazy: Option<lazy::Lazy<'b, C>>,
+    /// The spans of [`flat_rows_in_range`]'s batches (here, not in its
+    /// frame: set once a strip, not once a triangle).
+    pub spans: [[u32; 3]; ROW_BATCH],
 }
 
 /// A hull row holding no column.
@@ -925,7 +928,7 @@ pub(crate) fn draw<
     strip: &mut Strip<'_, C, D>,
     fragment: &F,
 ) -> u32 {
-    let written = match (D::WIDE, fits_i32(t)) {
+    let written = match (D::WIDE, t.edge32) {
         (true, true) => draw_in::<S, N, C, D, F, f64, i32>(t, strip, fragment),
         (true, false) => draw_in::<S, N, C, D, F, f64, i64>(t, strip, fragment),
         (false, true) => draw_in::<S, N, C, D, F, f32, i32>(t, strip, fragment),
@@ -1504,8 +1507,7 @@ fn flat_rows_in_range<
         return written;
     }
     // A horizontal edge covers whole rows or none: the rows it covers are
-    // a run, and cut to it, the edge bounds no span (a left edge of step
-    // 1, below).
+    // a run, and cut to it, the edge bounds no span ([`FLAT`], below).
     let (mut first, mut end) = (0i64, rows as i64);
     for e in edges.iter() {
         if e.step_x == T::ZERO {
@@ -1532,95 +1534,167 @@ fn flat_rows_in_range<
         base += first as usize * strip.width;
     }
     let rows = (end - first) as usize;
-    // Each edge's side, a bit a left edge (horizontal ones count as left);
-    // a triangle has one of each at least, so six patterns.
-    let sides = edges
-        .iter()
-        .enumerate()
-        .fold(0u8, |b, (k, e)| b | ((e.step_x >= T::ZERO) as u8) << k);
+    // Each edge's side, two bits an edge ([`RIGHT`], [`LEFT`] or [`FLAT`]):
+    // a triangle has a left and a right edge, the third any of the three,
+    // so twelve patterns.
+    let sides = edges.iter().enumerate().fold(0u8, |b, (k, e)| {
+        let side = match e.step_x.cmp(&T::ZERO) {
+            core::cmp::Ordering::Greater => LEFT,
+            core::cmp::Ordering::Less => RIGHT,
+            core::cmp::Ordering::Equal => FLAT,
+        };
+        b | side << (2 * k)
+    });
     let max_n = T::from_usize(max_n);
-    // (A `heapless::Vec`: filled, not cleared first.)
-    let mut batch = heapless::Vec::<[u32; 3], ROW_BATCH>::new();
     let mut left = rows;
     while left > 0 {
         let n = left.min(ROW_BATCH);
-        let out = (&mut batch, n, base, strip.width);
-        match sides {
-            1 => batch_spans::<R, T, 1>(&mut edges, plane, max_n, out),
-            2 => batch_spans::<R, T, 2>(&mut edges, plane, max_n, out),
-            3 => batch_spans::<R, T, 3>(&mut edges, plane, max_n, out),
-            4 => batch_spans::<R, T, 4>(&mut edges, plane, max_n, out),
-            5 => batch_spans::<R, T, 5>(&mut edges, plane, max_n, out),
-            _ => batch_spans::<R, T, 6>(&mut edges, plane, max_n, out),
-        }
-        written += strip
+        let out = (&mut strip.spans, n, base, strip.width);
+        let (k, drawn) = match sides {
+            P_LLR => batch_spans::<R, T, P_LLR>(&mut edges, plane, max_n, out),
+            P_LRL => batch_spans::<R, T, P_LRL>(&mut edges, plane, max_n, out),
+            P_RLL => batch_spans::<R, T, P_RLL>(&mut edges, plane, max_n, out),
+            P_RRL => batch_spans::<R, T, P_RRL>(&mut edges, plane, max_n, out),
+            P_RLR => batch_spans::<R, T, P_RLR>(&mut edges, plane, max_n, out),
+            P_LRR => batch_spans::<R, T, P_LRR>(&mut edges, plane, max_n, out),
+            P_FLR => batch_spans::<R, T, P_FLR>(&mut edges, plane, max_n, out),
+            P_FRL => batch_spans::<R, T, P_FRL>(&mut edges, plane, max_n, out),
+            P_LFR => batch_spans::<R, T, P_LFR>(&mut edges, plane, max_n, out),
+            P_RFL => batch_spans::<R, T, P_RFL>(&mut edges, plane, max_n, out),
+            P_LRF => batch_spans::<R, T, P_LRF>(&mut edges, plane, max_n, out),
+            P_RLF => batch_spans::<R, T, P_RLF>(&mut edges, plane, max_n, out),
+            // (No other pattern has positive area.)
+            _ => (0, 0),
+        };
+        let spans = &strip.spans[..k];
+        let missed = strip
             .depth
-            .flat_spans_in_range(strip.color, &batch, plane.dz_fixed, cmp, px);
+            .flat_spans_in_range(strip.color, spans, plane.dz_fixed, cmp, px);
+        written += drawn - missed;
         base += n * strip.width;
         left -= n;
     }
     written
 }
 
+/// An edge that bounds spans on the right (`step_x < 0`), on the left
+/// (`step_x > 0`), or neither (horizontal): [`batch_spans`]'s sides, two
+/// bits an edge ([`sides3`]).
+const RIGHT: u8 = 0;
+const LEFT: u8 = 1;
+const FLAT: u8 = 2;
+
+/// The sides of edges 0, 1 and 2 as one pattern.
+const fn sides3(a: u8, b: u8, c: u8) -> u8 {
+    a | b << 2 | c << 4
+}
+
+/// Edges 0, 1, 2: left, left, right.
+const P_LLR: u8 = sides3(LEFT, LEFT, RIGHT);
+/// Edges 0, 1, 2: left, right, left.
+const P_LRL: u8 = sides3(LEFT, RIGHT, LEFT);
+/// Edges 0, 1, 2: right, left, left.
+const P_RLL: u8 = sides3(RIGHT, LEFT, LEFT);
+/// Edges 0, 1, 2: right, right, left.
+const P_RRL: u8 = sides3(RIGHT, RIGHT, LEFT);
+/// Edges 0, 1, 2: right, left, right.
+const P_RLR: u8 = sides3(RIGHT, LEFT, RIGHT);
+/// Edges 0, 1, 2: left, right, right.
+const P_LRR: u8 = sides3(LEFT, RIGHT, RIGHT);
+/// Edges 0, 1, 2: flat, left, right.
+const P_FLR: u8 = sides3(FLAT, LEFT, RIGHT);
+/// Edges 0, 1, 2: flat, right, left.
+const P_FRL: u8 = sides3(FLAT, RIGHT, LEFT);
+/// Edges 0, 1, 2: left, flat, right.
+const P_LFR: u8 = sides3(LEFT, FLAT, RIGHT);
+/// Edges 0, 1, 2: right, flat, left.
+const P_RFL: u8 = sides3(RIGHT, FLAT, LEFT);
+/// Edges 0, 1, 2: left, right, flat.
+const P_LRF: u8 = sides3(LEFT, RIGHT, FLAT);
+/// Edges 0, 1, 2: right, left, flat.
+const P_RLF: u8 = sides3(RIGHT, LEFT, FLAT);
+
 /// Rows whose spans [`flat_rows_in_range`] finds before it draws them:
 /// each loop then keeps its own values in registers (one loop doing both
-/// spilled a third of them every row).
-const ROW_BATCH: usize = 16;
+/// spilled a third of them every row). Their storage is the `Strip`'s
+/// (144 bytes). On the Cortex-M4F, four cubes in 12-row strips (when this
+/// was chosen): 409,560 instructions a frame with 12, 410,240 with 16,
+/// 413,160 with 10, 422,720 with 8; with 16 the house's firmware
+/// (`house-portals`) outgrew its 24 KB of RAM.
+pub(crate) const ROW_BATCH: usize = 12;
 
 /// The spans of the next `n` rows, the first starting at `base` in the
 /// buffers, the rest `width` apart: `[start, length, Z32 start]` each
 /// (none for an empty row; a strip's buffers, whose index fits `u32`,
-/// hold every start), for edges whose sides are `SIDES` (bit `k`:
-/// edge `k` bounds spans on the left). The same spans as three
+/// hold every start), and the sum of their lengths, for edges whose
+/// sides are `SIDES` ([`sides3`]). The same spans as three
 /// [`Edge::clip_span`]s, without a branch on a side: a left edge of step
 /// `d > 0` covers `n >= ceil(-E / d)`, which is `(d - 1 - E) / d`
 /// truncated when `E <= 0` and at most 0 (no bound) otherwise; a right
-/// edge of step `-d` covers `n <= floor(E / d)`, which is `E / d` when `E
-/// >= 0`, and for `E < 0` nothing: or-ing in the sign (`E >> 31`, all
-/// ones) makes the bound -1. A horizontal edge, whose rows are cut to
-/// where `E >= 0`, is a left edge of step 1: `-E <= 0`, no bound. The
-/// operands stay in the ranges [`EDGE32_SPAN`] proves.
+/// edge of step `-d` covers `n <= floor(E / d)`, which is `E / d` when
+/// `E >= 0`, and for `E < 0` nothing: or-ing in the sign (`E >> 31`, all
+/// ones) makes the bound -1. A horizontal edge bounds nothing: its
+/// caller has cut the rows to where its `E >= 0`. The operands stay in
+/// the ranges [`EDGE32_SPAN`] proves; each divisor is at least 1 (no
+/// division check).
 #[inline(never)]
 fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
     edges: &mut [Edge<T>; 3],
     plane: &DepthPlane<R>,
     max_n: T,
-    (out, n, base, width): (&mut heapless::Vec<[u32; 3], ROW_BATCH>, usize, usize, usize),
-) {
+    (out, n, base, width): (&mut [[u32; 3]; ROW_BATCH], usize, usize, usize),
+) -> (usize, u32) {
+    let side = |k: usize| (SIDES >> (2 * k)) & 3;
+    // Each edge's `|step_x|` (at least 1: no division check), and its
+    // step as a multiple of it (0 for a horizontal edge).
     let d: [T; 3] = core::array::from_fn(|k| {
         let a = edges[k].step_x;
-        if SIDES & 1 << k != 0 {
+        if side(k) == LEFT {
             a.max(T::ONE)
         } else {
             (-a).max(T::ONE)
         }
     });
+    let step_x = |k: usize| match side(k) {
+        LEFT => d[k],
+        RIGHT => -d[k],
+        _ => T::ZERO,
+    };
     let mut e = [edges[0].row, edges[1].row, edges[2].row];
-    out.clear();
-    let mut row = base;
+    let mut slots = out.iter_mut();
+    let (mut row, mut total) = (base, 0u32);
     for _ in 0..n {
         let (mut lo, mut hi) = (T::ZERO, max_n);
         for k in 0..3 {
-            if SIDES & 1 << k != 0 {
-                lo = lo.max((d[k] - T::ONE - e[k]) / d[k]);
-            } else {
-                hi = hi.min(e[k].sign_mask() | (e[k] / d[k]));
+            match side(k) {
+                LEFT => lo = lo.max((d[k] - T::ONE - e[k]) / d[k]),
+                RIGHT => hi = hi.min(e[k].sign_mask() | (e[k] / d[k])),
+                _ => {}
             }
         }
         if lo <= hi {
-            let z0 = plane.z_at(e[1] + edges[1].step_x * lo, e[2] + edges[2].step_x * lo);
+            let z0 = plane.z_at(e[1] + step_x(1) * lo, e[2] + step_x(2) * lo);
             let start = row.wrapping_add(lo.widen() as usize) as u32;
-            // (`n <= ROW_BATCH`: every push fits.)
-            let _ = out.push([start, (hi - lo).widen() as u32 + 1, z0.round_in_range()]);
+            // (`n <= ROW_BATCH`: every span has a slot.)
+            if let Some(slot) = slots.next() {
+                let len = (hi - lo).widen() as u32 + 1;
+                *slot = [start, len, z0.round_in_range()];
+                total += len;
+            }
         }
         row = row.wrapping_add(width);
         for k in 0..3 {
             e[k] += edges[k].step_y;
         }
+        // (An empty barrier: LLVM unrolled the loop by two without it,
+        // and spilled half of its values; 4,600 instructions more on the
+        // Cortex-M4F's four cubes.)
+        core::hint::black_box(());
     }
     for k in 0..3 {
         edges[k].row = e[k];
     }
+    (ROW_BATCH - slots.len(), total)
 }
 
 #[cfg(test)]

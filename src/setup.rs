@@ -56,6 +56,9 @@ pub struct SetupTriangle<const N: usize = 3> {
     pub(crate) flat: Rgb888,
     /// Whether the varyings vary over the triangle.
     pub(crate) smooth: bool,
+    /// Whether its edge values fit `i32` (`raster::fits_i32`, once per
+    /// frame, not once per strip; a byte the struct's padding had).
+    pub(crate) edge32: bool,
     /// The caller's triangle index.
     pub(crate) id: u32,
 }
@@ -75,6 +78,7 @@ impl<const N: usize> SetupTriangle<N> {
         var_w: [[0.0; N]; 3],
         flat: Rgb888::new(0, 0, 0),
         smooth: false,
+        edge32: false,
         id: 0,
     };
 
@@ -318,6 +322,7 @@ impl Geometry {
             var_w,
             flat,
             smooth,
+            edge32: crate::raster::fits_i32(self.x, self.y),
             id,
         }
     }

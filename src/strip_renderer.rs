@@ -228,6 +228,7 @@ where
                     track: false,
                     #[cfg(feature = "lazy-clear")]
                     lazy: None,
+                    spans: [[0; 3]; crate::raster::ROW_BATCH],
                 },
                 fragment,
                 render: RenderStats::default(),
