@@ -210,20 +210,15 @@ impl_edge_int!(i64, from_i64);
 /// sides of the limit against the `i128` reference).
 pub const EDGE32_SPAN: i64 = 45_000;
 
-/// Whether the triangle's edge values fit `i32` ([`EDGE32_SPAN`]). Always
+/// Whether a triangle's edge values fit `i32` ([`EDGE32_SPAN`]), from
+/// its vertices' spans (max - min, in `Sub<S>` units) in x and in y:
+/// computed once, at setup, where the box's extremes are at hand. Always
 /// `false` with the `no-i32-edges` feature, which exists to measure what
 /// the `i32` path saves (`microraster report speed-vs-error`, the firmware's
 /// counts); the pixels are the same.
 #[inline]
-pub(crate) fn fits_i32(x: [i32; 3], y: [i32; 3]) -> bool {
-    if cfg!(feature = "no-i32-edges") {
-        return false;
-    }
-    // max - min is in [0, 2^32): exact as a wrapping `u32` difference.
-    let span = |v: [i32; 3]| {
-        (v[0].max(v[1]).max(v[2]) as u32).wrapping_sub(v[0].min(v[1]).min(v[2]) as u32)
-    };
-    span(x) <= EDGE32_SPAN as u32 && span(y) <= EDGE32_SPAN as u32
+pub(crate) fn fits_i32(span_x: i64, span_y: i64) -> bool {
+    !cfg!(feature = "no-i32-edges") && span_x <= EDGE32_SPAN && span_y <= EDGE32_SPAN
 }
 
 /// One edge function, set up for stepping in whole pixels.
@@ -1620,8 +1615,9 @@ const P_RLF: u8 = sides3(RIGHT, LEFT, FLAT);
 /// (144 bytes). On the Cortex-M4F, four cubes in 12-row strips (when this
 /// was chosen): 409,560 instructions a frame with 12, 410,240 with 16,
 /// 413,160 with 10, 422,720 with 8; with 16 the house's firmware
-/// (`house-portals`) outgrew its 24 KB of RAM.
-pub(crate) const ROW_BATCH: usize = 12;
+/// (`house-portals`) outgrew its 24 KB of RAM. Where division is slow the
+/// rows are not batched (the `Strip` keeps one slot, unused).
+pub(crate) const ROW_BATCH: usize = if DIVIDE_IS_SLOW { 1 } else { 12 };
 
 /// The spans of the next `n` rows, the first starting at `base` in the
 /// buffers, the rest `width` apart: `[start, length, Z32 start]` each

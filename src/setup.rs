@@ -199,6 +199,8 @@ pub(crate) struct Geometry {
     area: i64,
     swapped: bool,
     bbox: [u16; 4],
+    /// `raster::fits_i32` of the vertices, from the box's extremes.
+    edge32: bool,
 }
 
 /// Area, culling, winding and bounding box of a snapped triangle.
@@ -250,6 +252,7 @@ pub(crate) fn setup_geometry<const S: u32>(
         return Err(Rejected::Offscreen);
     }
     let clamp = |v: i64, hi: i64| v.clamp(0, hi) as u16;
+    let edge32 = crate::raster::fits_i32(max_x - min_x, max_y - min_y);
     Ok(Geometry {
         x,
         y,
@@ -262,6 +265,7 @@ pub(crate) fn setup_geometry<const S: u32>(
             clamp(py0, h - 1),
             clamp(py1, h - 1),
         ],
+        edge32,
     })
 }
 
@@ -322,7 +326,7 @@ impl Geometry {
             var_w,
             flat,
             smooth,
-            edge32: crate::raster::fits_i32(self.x, self.y),
+            edge32: self.edge32,
             id,
         }
     }
