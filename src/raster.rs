@@ -102,6 +102,8 @@ trait EdgeInt:
 {
     const ZERO: Self;
     const ONE: Self;
+    /// `i64`: the type of the rare triangles too wide for `i32`.
+    const WIDE: bool;
     /// `v`, which the caller has proved to fit.
     fn narrow(v: i64) -> Self;
     fn widen(self) -> i64;
@@ -133,6 +135,7 @@ macro_rules! impl_edge_int {
         impl EdgeInt for $t {
             const ZERO: $t = 0;
             const ONE: $t = 1;
+            const WIDE: bool = <$t>::BITS > 32;
             #[inline(always)]
             fn narrow(v: i64) -> $t {
                 debug_assert!(<$t>::try_from(v).is_ok(), "{v} does not fit");
@@ -1477,7 +1480,10 @@ fn flat_rows_in_range<
 ) -> u32 {
     let cmp = if LESS { cmp::LESS } else { cmp };
     let mut written = 0u32;
-    if DIVIDE_IS_SLOW {
+    // Batched only for `i32` edges: the rare wider triangles take the
+    // row loop (their own 24 copies of the span finder were 7 KB of
+    // flash).
+    if DIVIDE_IS_SLOW || T::WIDE {
         let mut spans = RowSpans::new(&edges, max_n);
         for _ in 0..rows {
             if let Some((lo, hi)) = spans.span(&edges) {
