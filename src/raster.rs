@@ -54,7 +54,13 @@
 //! out of `[0, 2^32)`: its spans skip the per-span range check and the
 //! clamp, and step one `u32` (`flat_rows_in_range`). The words are the
 //! ones the checked path writes (a property test compares the two on
-//! depths a few `f32` steps from the planes).
+//! depths a few `f32` steps from the planes). On cores that divide, with
+//! `i32` edges, those rows go in batches (`ROW_BATCH`): each row's span
+//! and depth start first (`batch_spans`, a copy per pattern of edge
+//! sides, so no branch on a side), then the whole batch in one call to
+//! the buffer's loop: the spans of `Edge::clip_span` and the same depth
+//! starts (the coverage properties compare both paths with the `i128`
+//! reference, and the `u16` depths with the `u32` path's).
 //!
 //! Varyings, when they vary, are perspective-correct: `sum(E_k v_k / w_k)
 //! / sum(E_k / w_k)` with the exact edge values converted to `f32` at the
@@ -1481,8 +1487,8 @@ fn flat_rows_in_range<
     let cmp = if LESS { cmp::LESS } else { cmp };
     let mut written = 0u32;
     // Batched only for `i32` edges: the rare wider triangles take the
-    // row loop (their own 24 copies of the span finder were 7 KB of
-    // flash).
+    // row loop (their own copies of the span finder were 6.5 KB of flash
+    // on the Cortex-M4F).
     if DIVIDE_IS_SLOW || T::WIDE {
         let mut spans = RowSpans::new(&edges, max_n);
         for _ in 0..rows {
