@@ -206,12 +206,7 @@ pub trait DepthBuffer {
         cmp: u8,
         px: C,
     ) -> u32 {
-        let mut missed = 0;
-        for &[start, len, z0] in spans {
-            missed +=
-                len - self.flat_span_in_range(color, start as usize, len as usize, z0, dz, cmp, px);
-        }
-        missed
+        spans_one_by_one(self, color, spans, dz, cmp, px)
     }
 
     /// Sets values `start..start + len` (those held) to the depth `z32`
@@ -342,6 +337,27 @@ fn span_z32<W: DepthWord, C: Copy, const CMP: u8>(
     px: C,
 ) -> u32 {
     z32_loop::<W, C, CMP>(c, d, z0, dz, px)
+}
+
+/// [`DepthBuffer::flat_spans_in_range`] as one
+/// [`flat_span_in_range`](DepthBuffer::flat_span_in_range) a span: the
+/// default, and the slices' on 64-bit hosts (whose span loop is
+/// branch-free). Returns the pixels not written.
+#[inline(always)]
+fn spans_one_by_one<D: DepthBuffer + ?Sized, C: Copy>(
+    depth: &mut D,
+    color: &mut [C],
+    spans: &[[u32; 3]],
+    dz: i64,
+    cmp: u8,
+    px: C,
+) -> u32 {
+    let mut missed = 0;
+    for &[start, len, z0] in spans {
+        let (at, n) = (start as usize, len as usize);
+        missed += len - depth.flat_span_in_range(color, at, n, z0, dz, cmp, px);
+    }
+    missed
 }
 
 /// [`span_z32`] for each row of a batch (see
@@ -872,12 +888,7 @@ impl<W: DepthWord> DepthBuffer for [W] {
     ) -> u32 {
         debug_assert!(W::FRAC == 0);
         if cfg!(target_pointer_width = "64") {
-            let mut missed = 0;
-            for &[start, len, z0] in spans {
-                let (at, n) = (start as usize, len as usize);
-                missed += len - self.flat_span_in_range(color, at, n, z0, dz, cmp, px);
-            }
-            return missed;
+            return spans_one_by_one(self, color, spans, dz, cmp, px);
         }
         let rows = (color, self, spans);
         match cmp {

@@ -1596,29 +1596,19 @@ const fn sides3(a: u8, b: u8, c: u8) -> u8 {
     a | b << 2 | c << 4
 }
 
-/// Edges 0, 1, 2: left, left, right.
+// The twelve patterns with area, edges 0, 1 and 2 in order (L left, R
+// right, F flat): two sides of three, or a flat edge and one of each.
 const P_LLR: u8 = sides3(LEFT, LEFT, RIGHT);
-/// Edges 0, 1, 2: left, right, left.
 const P_LRL: u8 = sides3(LEFT, RIGHT, LEFT);
-/// Edges 0, 1, 2: right, left, left.
 const P_RLL: u8 = sides3(RIGHT, LEFT, LEFT);
-/// Edges 0, 1, 2: right, right, left.
 const P_RRL: u8 = sides3(RIGHT, RIGHT, LEFT);
-/// Edges 0, 1, 2: right, left, right.
 const P_RLR: u8 = sides3(RIGHT, LEFT, RIGHT);
-/// Edges 0, 1, 2: left, right, right.
 const P_LRR: u8 = sides3(LEFT, RIGHT, RIGHT);
-/// Edges 0, 1, 2: flat, left, right.
 const P_FLR: u8 = sides3(FLAT, LEFT, RIGHT);
-/// Edges 0, 1, 2: flat, right, left.
 const P_FRL: u8 = sides3(FLAT, RIGHT, LEFT);
-/// Edges 0, 1, 2: left, flat, right.
 const P_LFR: u8 = sides3(LEFT, FLAT, RIGHT);
-/// Edges 0, 1, 2: right, flat, left.
 const P_RFL: u8 = sides3(RIGHT, FLAT, LEFT);
-/// Edges 0, 1, 2: left, right, flat.
 const P_LRF: u8 = sides3(LEFT, RIGHT, FLAT);
-/// Edges 0, 1, 2: right, left, flat.
 const P_RLF: u8 = sides3(RIGHT, LEFT, FLAT);
 
 /// Rows whose spans [`flat_rows_in_range`] finds before it draws them:
