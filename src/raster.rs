@@ -1557,22 +1557,19 @@ fn flat_rows_in_range<
     while left > 0 {
         let n = left.min(ROW_BATCH);
         let out = (&mut strip.spans, n, base, strip.width);
-        let (k, drawn) = match sides {
-            P_LLR => batch_spans::<R, T, P_LLR>(&mut edges, plane, max_n, out),
-            P_LRL => batch_spans::<R, T, P_LRL>(&mut edges, plane, max_n, out),
-            P_RLL => batch_spans::<R, T, P_RLL>(&mut edges, plane, max_n, out),
-            P_RRL => batch_spans::<R, T, P_RRL>(&mut edges, plane, max_n, out),
-            P_RLR => batch_spans::<R, T, P_RLR>(&mut edges, plane, max_n, out),
-            P_LRR => batch_spans::<R, T, P_LRR>(&mut edges, plane, max_n, out),
-            P_FLR => batch_spans::<R, T, P_FLR>(&mut edges, plane, max_n, out),
-            P_FRL => batch_spans::<R, T, P_FRL>(&mut edges, plane, max_n, out),
-            P_LFR => batch_spans::<R, T, P_LFR>(&mut edges, plane, max_n, out),
-            P_RFL => batch_spans::<R, T, P_RFL>(&mut edges, plane, max_n, out),
-            P_LRF => batch_spans::<R, T, P_LRF>(&mut edges, plane, max_n, out),
-            P_RLF => batch_spans::<R, T, P_RLF>(&mut edges, plane, max_n, out),
-            // (No other pattern has positive area.)
-            _ => (0, 0),
-        };
+        // One copy of the span finder a pattern.
+        macro_rules! by_sides {
+            ($($p:ident),*) => {
+                match sides {
+                    $($p => batch_spans::<R, T, $p>(&mut edges, plane, max_n, out),)*
+                    // (No other pattern has positive area.)
+                    _ => (0, 0),
+                }
+            };
+        }
+        let (k, drawn) = by_sides!(
+            P_LLR, P_LRL, P_RLL, P_RRL, P_RLR, P_LRR, P_FLR, P_FRL, P_LFR, P_RFL, P_LRF, P_RLF
+        );
         let spans = &strip.spans[..k];
         let missed = strip
             .depth
