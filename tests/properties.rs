@@ -1264,40 +1264,85 @@ proptest! {
         for (p, z) in pos.iter_mut().zip(z) {
             p.z = z * p.w;
         }
-        let n = (w * h) as usize;
-        let depth = |func, clear| {
-            let mut cfg = config_nocull(w, h);
-            cfg.depth_func = func;
-            let mut st = storage(1);
-            let mut frame = Frame::<8>::with_subpixel_bits(cfg, &mut st).unwrap();
-            frame.submit_clip_triangle(pos, [Rgb888::new(9, 8, 7); 3], 0).unwrap();
-            let mut c = vec![Rgb888::new(0, 0, 0); n];
-            let mut z = vec![clear; n];
-            frame.render_rows(0, h, &mut c[..], &mut z[..]).unwrap();
-            (c, z)
-        };
-        // Every ordered test against the clear it passes everywhere but at
-        // the clear value itself (`Greater` and `GreaterEqual` as 1/w
-        // depth draws them, cleared to 0).
-        for (func, clear) in [
-            (DepthFunc::Less, u16::MAX),
-            (DepthFunc::LessEqual, u16::MAX),
-            (DepthFunc::Greater, 0),
-            (DepthFunc::GreaterEqual, 0),
-        ] {
-            let (fast_c, fast_z) = depth(func, clear);
-            let (all_c, all_z) = depth(DepthFunc::Always, clear);
-            let equal_passes = matches!(func, DepthFunc::LessEqual | DepthFunc::GreaterEqual);
-            for k in 0..n {
-                if all_z[k] != clear || equal_passes {
-                    prop_assert_eq!(fast_z[k], all_z[k], "{:?}: depth at pixel {}", func, k);
-                    prop_assert_eq!(fast_c[k], all_c[k], "{:?}: colour at pixel {}", func, k);
-                } else {
-                    prop_assert_eq!(fast_z[k], clear);
-                }
+        prop_assert!(check_unchecked_u16_spans(w, h, pos)?, "rejected");
+    }
+
+    /// Named hard case of the same: vertices exactly at pixel centres,
+    /// their depths exactly on the planes (NDC -1 and 1: `Z32` 0 and
+    /// `2^32 - 1`) or anywhere. A covered pixel centre at a vertex on a
+    /// plane has its exact depth on it, where any error of the `f32` span
+    /// start or step would leave `[0, 2^32)` and wrap; `z_never_clamps`
+    /// must send such triangles to the clamped loop. (With its test
+    /// forced true, this fails within a few hundred cases; the property
+    /// above, off the pixel centres, did not.)
+    #[test]
+    fn u16_spans_with_vertices_on_the_planes_at_pixel_centres(
+        w in 8u32..=48,
+        h in 8u32..=48,
+        p in [(0u32..48, 0u32..48), (0u32..48, 0u32..48), (0u32..48, 0u32..48)],
+        z in [on_a_plane(), on_a_plane(), on_a_plane()],
+    ) {
+        let pos: [Vec4; 3] = core::array::from_fn(|k| {
+            let (x, y) = ((p[k].0 % w) as f64 + 0.5, (p[k].1 % h) as f64 + 0.5);
+            wvzw(x, y, z[k], 1.0, w, h)
+        });
+        check_unchecked_u16_spans(w, h, pos)?;
+    }
+}
+
+/// NDC depth -1 or 1 (the planes; mostly), or anywhere between.
+fn on_a_plane() -> impl Strategy<Value = f64> {
+    prop_oneof![2 => Just(-1.0f64), 2 => Just(1.0f64), 1 => -1.0f64..=1.0]
+}
+
+/// [`unchecked_u16_spans_equal_the_clamped_path`]'s check: the flat
+/// triangle `pos` drawn into a `u16` buffer under each ordered test (the
+/// unchecked span path where `z_never_clamps` holds) writes the depths and
+/// colours that `Always` (the clamped per-pixel path) writes. Returns
+/// whether the triangle was accepted.
+fn check_unchecked_u16_spans(w: u32, h: u32, pos: [Vec4; 3]) -> Result<bool, TestCaseError> {
+    let n = (w * h) as usize;
+    let mut accepted = true;
+    let mut depth = |func, clear| {
+        let mut cfg = config_nocull(w, h);
+        cfg.depth_func = func;
+        let mut st = storage(1);
+        let mut frame = Frame::<8>::with_subpixel_bits(cfg, &mut st).unwrap();
+        // (Rejected triangles draw nothing on either path.)
+        accepted &= frame
+            .submit_clip_triangle(pos, [Rgb888::new(9, 8, 7); 3], 0)
+            .is_ok();
+        let mut c = vec![Rgb888::new(0, 0, 0); n];
+        let mut z = vec![clear; n];
+        frame.render_rows(0, h, &mut c[..], &mut z[..]).unwrap();
+        (c, z)
+    };
+    // Every ordered test against the clear it passes everywhere but at
+    // the clear value itself (`Greater` and `GreaterEqual` as 1/w depth
+    // draws them, cleared to 0).
+    for (func, clear) in [
+        (DepthFunc::Less, u16::MAX),
+        (DepthFunc::LessEqual, u16::MAX),
+        (DepthFunc::Greater, 0),
+        (DepthFunc::GreaterEqual, 0),
+    ] {
+        let (fast_c, fast_z) = depth(func, clear);
+        let (all_c, all_z) = depth(DepthFunc::Always, clear);
+        let equal_passes = matches!(func, DepthFunc::LessEqual | DepthFunc::GreaterEqual);
+        for k in 0..n {
+            if all_z[k] != clear || equal_passes {
+                prop_assert_eq!(fast_z[k], all_z[k], "{:?}: depth at pixel {}", func, k);
+                prop_assert_eq!(fast_c[k], all_c[k], "{:?}: colour at pixel {}", func, k);
+            } else {
+                prop_assert_eq!(fast_z[k], clear);
             }
         }
     }
+    Ok(accepted)
+}
+
+proptest! {
+    #![proptest_config(cases(2048))]
 }
 
 /// `u16` depth, `u32` depth and the written mask of one flat triangle
