@@ -1305,10 +1305,9 @@ fn flat_rows<
     let mut edges: [Edge<T>; 3] = edges_at::<S, N, T>(t, row_first);
     let rows = row_last - row_first + 1;
     let max_n = (t.max_x - t.min_x) as usize;
-    let z = t.z;
     let mut base =
         (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
-    if D::ENABLED && D::FRAC == 0 && strip.depth_write && z_never_clamps(z, max_n) {
+    if D::ENABLED && D::FRAC == 0 && strip.depth_write && t.flat_facts & Z_IN_RANGE != 0 {
         let cmp = match strip.depth_func {
             DepthFunc::Less => Some(cmp::LESS),
             DepthFunc::LessEqual => Some(cmp::LESS_EQUAL),
@@ -1324,14 +1323,17 @@ fn flat_rows<
             base,
             max_n,
         );
+        let sides = t.flat_facts & SIDES;
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
         match cmp {
             Some(cmp::LESS) => {
-                return flat_rows_in_range::<N, C, D, R, T, true>(args, strip, cmp::LESS, px)
+                return flat_rows_in_range::<N, C, D, R, T, true>(args, sides, strip, cmp::LESS, px)
             }
-            Some(cmp) => return flat_rows_in_range::<N, C, D, R, T, false>(args, strip, cmp, px),
+            Some(cmp) => {
+                return flat_rows_in_range::<N, C, D, R, T, false>(args, sides, strip, cmp, px)
+            }
             None => {}
         }
     }
@@ -1383,10 +1385,9 @@ fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: R
 ) -> u32 {
     let rows = row_last - row_first + 1;
     let max_n = (t.max_x - t.min_x) as usize;
-    let z = t.z;
     let mut base =
         (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
-    if D::ENABLED && D::FRAC == 0 && strip.depth_write && z_never_clamps(z, max_n) {
+    if D::ENABLED && D::FRAC == 0 && strip.depth_write && t.flat_facts & Z_IN_RANGE != 0 {
         let cmp = match strip.depth_func {
             DepthFunc::Less => Some(cmp::LESS),
             DepthFunc::LessEqual => Some(cmp::LESS_EQUAL),
@@ -1394,15 +1395,20 @@ fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: R
             DepthFunc::GreaterEqual => Some(cmp::GREATER_EQUAL),
             _ => None,
         };
-        let args = (edges, &shader.plane(), rows, base, max_n);
+        let (args, sides) = (
+            (edges, &shader.plane(), rows, base, max_n),
+            t.flat_facts & SIDES,
+        );
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
         match cmp {
             Some(cmp::LESS) => {
-                return flat_rows_in_range::<N, C, D, R, T, true>(args, strip, cmp::LESS, px)
+                return flat_rows_in_range::<N, C, D, R, T, true>(args, sides, strip, cmp::LESS, px)
             }
-            Some(cmp) => return flat_rows_in_range::<N, C, D, R, T, false>(args, strip, cmp, px),
+            Some(cmp) => {
+                return flat_rows_in_range::<N, C, D, R, T, false>(args, sides, strip, cmp, px)
+            }
             None => {}
         }
     }
@@ -1480,6 +1486,7 @@ fn flat_rows_in_range<
     const LESS: bool,
 >(
     (mut edges, plane, rows, mut base, max_n): ([Edge<T>; 3], &DepthPlane<R>, u32, usize, usize),
+    sides: u8,
     strip: &mut Strip<'_, C, D>,
     cmp: u8,
     px: C,
@@ -1541,17 +1548,20 @@ fn flat_rows_in_range<
         base += first as usize * strip.width;
     }
     let rows = (end - first) as usize;
-    // Each edge's side, two bits an edge ([`RIGHT`], [`LEFT`] or [`FLAT`]):
-    // a triangle has a left and a right edge, the third any of the three,
-    // so twelve patterns.
-    let sides = edges.iter().enumerate().fold(0u8, |b, (k, e)| {
-        let side = match e.step_x.cmp(&T::ZERO) {
-            core::cmp::Ordering::Greater => LEFT,
-            core::cmp::Ordering::Less => RIGHT,
-            core::cmp::Ordering::Equal => FLAT,
-        };
-        b | side << (2 * k)
-    });
+    // Each edge's side, two bits an edge ([`RIGHT`], [`LEFT`] or [`FLAT`],
+    // found at setup: [`flat_facts`]): a triangle has a left and a right
+    // edge, the third any of the three, so twelve patterns.
+    debug_assert_eq!(
+        sides,
+        edges.iter().enumerate().fold(0u8, |b, (k, e)| {
+            let side = match e.step_x.cmp(&T::ZERO) {
+                core::cmp::Ordering::Greater => LEFT,
+                core::cmp::Ordering::Less => RIGHT,
+                core::cmp::Ordering::Equal => FLAT,
+            };
+            b | side << (2 * k)
+        })
+    );
     let max_n = T::from_usize(max_n);
     let mut left = rows;
     while left > 0 {
@@ -1580,6 +1590,34 @@ fn flat_rows_in_range<
     }
     written
 }
+
+/// [`SetupTriangle::flat_facts`](crate::SetupTriangle) of a triangle with
+/// vertex rows `y` (`Sub<S>`, wound as set up), depths `z` (`Z32`) and a
+/// box `max_n + 1` pixels wide: the sides of edges 0, 1 and 2 ([`sides3`];
+/// edge `k` runs from vertex `k + 1` to vertex `k + 2`, and its `step_x`
+/// is `-(y_b - y_a)` times the subpixel unit, so its side is the sign of
+/// `y_a - y_b`) in the [`SIDES`] bits, and [`Z_IN_RANGE`] where
+/// [`z_never_clamps`]. Both depend on the triangle alone, so setup finds
+/// them once a frame rather than [`flat_rows`] once a strip.
+pub(crate) fn flat_facts(y: [i32; 3], z: [u32; 3], max_n: usize) -> u8 {
+    let side = |ya: i32, yb: i32| match ya.cmp(&yb) {
+        core::cmp::Ordering::Greater => LEFT,
+        core::cmp::Ordering::Less => RIGHT,
+        core::cmp::Ordering::Equal => FLAT,
+    };
+    let sides = sides3(side(y[1], y[2]), side(y[2], y[0]), side(y[0], y[1]));
+    sides
+        | if z_never_clamps(z, max_n) {
+            Z_IN_RANGE
+        } else {
+            0
+        }
+}
+
+/// The bits of [`flat_facts`] that hold the sides pattern.
+const SIDES: u8 = 0x3f;
+/// The bit of [`flat_facts`] set where [`z_never_clamps`] holds.
+const Z_IN_RANGE: u8 = 0x80;
 
 /// An edge that bounds spans on the right (`step_x < 0`), on the left
 /// (`step_x > 0`), or neither (horizontal): [`batch_spans`]'s sides, two
@@ -1754,6 +1792,50 @@ mod tests {
         ) {
             let snap = |v: [i32; 3]| if coarse { v.map(|c| c & !0x3ff) } else { v };
             check_walk::<i32>(snap(x), snap(y))?;
+        }
+
+        /// The flat facts setup stores are the ones the edges give: each
+        /// edge's side from the sign of its `step_x` (as `i32` and `i64`
+        /// edges), and [`Z_IN_RANGE`] where `z_never_clamps` holds.
+        #[test]
+        fn flat_facts_are_the_edges_sides(
+            x in [0i32..45_000, 0i32..45_000, 0i32..45_000],
+            y in [0i32..45_000, 0i32..45_000, 0i32..45_000],
+            coarse in any::<bool>(),
+            z in [
+                prop_oneof![any::<u32>(), 0u32..1 << 16, u32::MAX - (1 << 16)..=u32::MAX],
+                prop_oneof![any::<u32>(), 0u32..1 << 16, u32::MAX - (1 << 16)..=u32::MAX],
+                prop_oneof![any::<u32>(), 0u32..1 << 16, u32::MAX - (1 << 16)..=u32::MAX],
+            ],
+            max_n in 0usize..4096,
+        ) {
+            let snap = |v: [i32; 3]| if coarse { v.map(|c| c & !0x3ff) } else { v };
+            let (x, y) = (snap(x), snap(y));
+            let facts = flat_facts(y, z, max_n);
+            let pattern = |steps: [i64; 3]| {
+                steps.iter().enumerate().fold(0u8, |b, (k, &s)| {
+                    let side = match s.cmp(&0) {
+                        core::cmp::Ordering::Greater => LEFT,
+                        core::cmp::Ordering::Less => RIGHT,
+                        core::cmp::Ordering::Equal => FLAT,
+                    };
+                    b | side << (2 * k)
+                })
+            };
+            let e32: [Edge<i32>; 3] = [
+                Edge::new::<8>(x[1], y[1], x[2], y[2], 128, 128),
+                Edge::new::<8>(x[2], y[2], x[0], y[0], 128, 128),
+                Edge::new::<8>(x[0], y[0], x[1], y[1], 128, 128),
+            ];
+            let e64: [Edge<i64>; 3] = [
+                Edge::new::<8>(x[1], y[1], x[2], y[2], 128, 128),
+                Edge::new::<8>(x[2], y[2], x[0], y[0], 128, 128),
+                Edge::new::<8>(x[0], y[0], x[1], y[1], 128, 128),
+            ];
+            prop_assert_eq!(facts & SIDES, pattern(e32.map(|e| e.step_x as i64)));
+            prop_assert_eq!(facts & SIDES, pattern(e64.map(|e| e.step_x)));
+            prop_assert_eq!(facts & Z_IN_RANGE != 0, z_never_clamps(z, max_n));
+            prop_assert_eq!(facts & !(SIDES | Z_IN_RANGE), 0);
         }
 
         /// `z_difference` converts the exact difference, by either route

@@ -59,6 +59,10 @@ pub struct SetupTriangle<const N: usize = 3> {
     /// Whether its edge values fit `i32` (`raster::fits_i32`, once per
     /// frame, not once per strip; a byte the struct's padding had).
     pub(crate) edge32: bool,
+    /// What its flat rows need to know of it (`raster::flat_facts`: its
+    /// edges' sides and whether its depths never clamp), once per frame,
+    /// not once per strip; another byte of the padding.
+    pub(crate) flat_facts: u8,
     /// The caller's triangle index.
     pub(crate) id: u32,
 }
@@ -79,6 +83,7 @@ impl<const N: usize> SetupTriangle<N> {
         flat: Rgb888::new(0, 0, 0),
         smooth: false,
         edge32: false,
+        flat_facts: 0,
         id: 0,
     };
 
@@ -327,6 +332,11 @@ impl Geometry {
             flat,
             smooth,
             edge32: self.edge32,
+            flat_facts: crate::raster::flat_facts(
+                self.y,
+                self.z,
+                (self.bbox[1] - self.bbox[0]) as usize,
+            ),
             id,
         }
     }
