@@ -7,8 +7,8 @@
 //! (anything else is an error, which the strip drawer hands back), and its
 //! pixels go, two to a 32-bit word as a DMA transfer packs them, into a
 //! checksum
-//! (`microraster_scenes::checksum`: two additions a word) instead of onto
-//! the wire. The checksum of a frame does not depend on how it was cut
+//! (`microraster_scenes::checksum`: two additions a word, eight words a
+//! loop turn) instead of onto the wire. The checksum of a frame does not depend on how it was cut
 //! into strips (rows are an even number of pixels wide). The instructions
 //! it spends are counted apart, on their own line.
 //!
@@ -167,15 +167,27 @@ where
         }
         let mut sum = self.sum;
         // Two pixels a word, as a 32-bit DMA transfer moves them (rows of
-        // an even width: no half word is left over).
-        let words = pixels.chunks_exact(2);
-        let rest = words.remainder();
-        for w in words {
+        // an even width: no half word is left over), eight words a turn:
+        // the loop the compiler made of one word a turn took four, and
+        // its counting 0.5 instructions a word (M4F four cubes: push
+        // 135,600 -> 118,960; sixteen words a turn, 118,880).
+        let word = |p: &[P]| {
             let (lo, hi): (u16, u16) = (
-                Rgb565::from(w[0]).into_storage(),
-                Rgb565::from(w[1]).into_storage(),
+                Rgb565::from(p[0]).into_storage(),
+                Rgb565::from(p[1]).into_storage(),
             );
-            sum.push_word(lo as u32 | (hi as u32) << 16);
+            lo as u32 | (hi as u32) << 16
+        };
+        let blocks = pixels.chunks_exact(16);
+        let words = blocks.remainder().chunks_exact(2);
+        let rest = words.remainder();
+        for b in blocks {
+            for w in b.chunks_exact(2) {
+                sum.push_word(word(w));
+            }
+        }
+        for w in words {
+            sum.push_word(word(w));
         }
         for &c in rest {
             sum.push(Rgb565::from(c).into_storage());
