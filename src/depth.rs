@@ -191,9 +191,8 @@ pub trait DepthBuffer {
     }
 
     /// [`flat_span_in_range`](DepthBuffer::flat_span_in_range) for a
-    /// batch of spans, each `[start, length, Z32 start]`; returns the
-    /// pixels of the spans it did not write (the caller, which made the
-    /// spans, has their sum). Buffers override it with one loop over the
+    /// batch of spans, each `[start, length, Z32 start]` (a length may be
+    /// 0); returns the pixels it wrote. Buffers override it with one loop over the
     /// spans (a call a span, and the arguments it takes, were a third of
     /// a small span's instructions on the Cortex-M4F).
     #[doc(hidden)]
@@ -352,12 +351,12 @@ fn spans_one_by_one<D: DepthBuffer + ?Sized, C: Copy>(
     cmp: u8,
     px: C,
 ) -> u32 {
-    let mut missed = 0;
+    let mut written = 0;
     for &[start, len, z0] in spans {
         let (at, n) = (start as usize, len as usize);
-        missed += len - depth.flat_span_in_range(color, at, n, z0, dz, cmp, px);
+        written += depth.flat_span_in_range(color, at, n, z0, dz, cmp, px);
     }
-    missed
+    written
 }
 
 /// [`span_z32`] for each row of a batch (see
@@ -370,16 +369,16 @@ fn spans_z32<W: DepthWord, C: Copy, const CMP: u8>(
     dz: u32,
     px: C,
 ) -> u32 {
-    let mut missed = 0u32;
+    let (mut drawn, mut missed) = (0u32, 0u32);
     for &[start, len, z0] in spans {
         let (start, end) = (start as usize, start as usize + len as usize);
-        match (c.get_mut(start..end), d.get_mut(start..end)) {
-            (Some(c), Some(d)) => z32_misses::<W, C, CMP>(c, d, z0, dz, px, &mut missed),
-            // (Never: the spans lie in the buffers.)
-            _ => missed += len,
+        // (Always: the spans lie in the buffers, or are empty.)
+        if let (Some(c), Some(d)) = (c.get_mut(start..end), d.get_mut(start..end)) {
+            drawn += len;
+            z32_misses::<W, C, CMP>(c, d, z0, dz, px, &mut missed)
         }
     }
-    missed
+    drawn - missed
 }
 
 /// The span of [`DepthBuffer::untested_span`], where every pixel passes:

@@ -1573,18 +1573,17 @@ fn flat_rows_in_range<
                 match sides {
                     $($p => batch_spans::<R, T, $p>(&mut edges, plane, max_n, out),)*
                     // (No other pattern has positive area.)
-                    _ => (0, 0),
+                    _ => 0,
                 }
             };
         }
-        let (k, drawn) = by_sides!(
+        let k = by_sides!(
             P_LLR, P_LRL, P_RLL, P_RRL, P_RLR, P_LRR, P_FLR, P_FRL, P_LFR, P_RFL, P_LRF, P_RLF
         );
         let spans = &strip.spans[..k];
-        let missed = strip
+        written += strip
             .depth
             .flat_spans_in_range(strip.color, spans, plane.dz_fixed, cmp, px);
-        written += drawn - missed;
         base += n * strip.width;
         left -= n;
     }
@@ -1676,7 +1675,7 @@ fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
     plane: &DepthPlane<R>,
     max_n: T,
     (out, n, base, width): (&mut [[u32; 3]; ROW_BATCH], usize, usize, usize),
-) -> (usize, u32) {
+) -> usize {
     let side = |k: usize| (SIDES >> (2 * k)) & 3;
     // Each edge's `|step_x|` (at least 1: no division check), and its
     // step as a multiple of it (0 for a horizontal edge).
@@ -1694,9 +1693,11 @@ fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
         _ => T::ZERO,
     };
     let mut e = [edges[0].row, edges[1].row, edges[2].row];
-    let mut slots = out.iter_mut();
-    let (mut row, mut total) = (base, 0u32);
-    for _ in 0..n {
+    let mut row = base;
+    // A slot every row (`n <= ROW_BATCH`), of length 0 where the row has
+    // no span: one count for the loop and the slots, no branch a row.
+    let k = n.min(ROW_BATCH);
+    for slot in out[..k].iter_mut() {
         let (mut lo, mut hi) = (T::ZERO, max_n);
         for k in 0..3 {
             match side(k) {
@@ -1705,16 +1706,14 @@ fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
                 _ => {}
             }
         }
-        if lo <= hi {
-            let z0 = plane.z_at(e[1] + step_x(1) * lo, e[2] + step_x(2) * lo);
-            let start = row.wrapping_add(lo.widen() as usize) as u32;
-            // (`n <= ROW_BATCH`: every span has a slot.)
-            if let Some(slot) = slots.next() {
-                let len = (hi - lo).widen() as u32 + 1;
-                *slot = [start, len, z0.round_in_range()];
-                total += len;
-            }
-        }
+        let z0 = plane.z_at(e[1] + step_x(1) * lo, e[2] + step_x(2) * lo);
+        let start = row.wrapping_add(lo.widen() as usize) as u32;
+        let len = if lo <= hi {
+            (hi - lo).widen() as u32 + 1
+        } else {
+            0
+        };
+        *slot = [start, len, z0.round_in_range()];
         row = row.wrapping_add(width);
         for k in 0..3 {
             e[k] += edges[k].step_y;
@@ -1727,7 +1726,7 @@ fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
     for k in 0..3 {
         edges[k].row = e[k];
     }
-    (ROW_BATCH - slots.len(), total)
+    k
 }
 
 #[cfg(test)]
