@@ -154,6 +154,8 @@ impl<const N: usize> Sink<N> for Store<'_, N> {
     fn take(&mut self, t: &SetupTriangle<N>) {
         if let Some(slot) = self.storage.get_mut(self.len) {
             *slot = *t;
+            // Once a frame, for every strip that draws it.
+            slot.flat_facts = crate::raster::flat_facts_of(t);
             self.len += 1;
         }
     }

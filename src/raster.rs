@@ -1307,7 +1307,12 @@ fn flat_rows<
     let max_n = (t.max_x - t.min_x) as usize;
     let mut base =
         (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
-    if D::ENABLED && D::FRAC == 0 && strip.depth_write && t.flat_facts & Z_IN_RANGE != 0 {
+    let facts = if D::ENABLED && D::FRAC == 0 && strip.depth_write {
+        facts(t)
+    } else {
+        0
+    };
+    if facts & Z_IN_RANGE != 0 {
         let cmp = match strip.depth_func {
             DepthFunc::Less => Some(cmp::LESS),
             DepthFunc::LessEqual => Some(cmp::LESS_EQUAL),
@@ -1323,7 +1328,7 @@ fn flat_rows<
             base,
             max_n,
         );
-        let sides = t.flat_facts & SIDES;
+        let sides = facts & SIDES;
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
@@ -1387,7 +1392,12 @@ fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: R
     let max_n = (t.max_x - t.min_x) as usize;
     let mut base =
         (row_first - strip.y0) as usize * strip.width + (t.min_x as u32 - strip.x0) as usize;
-    if D::ENABLED && D::FRAC == 0 && strip.depth_write && t.flat_facts & Z_IN_RANGE != 0 {
+    let facts = if D::ENABLED && D::FRAC == 0 && strip.depth_write {
+        facts(t)
+    } else {
+        0
+    };
+    if facts & Z_IN_RANGE != 0 {
         let cmp = match strip.depth_func {
             DepthFunc::Less => Some(cmp::LESS),
             DepthFunc::LessEqual => Some(cmp::LESS_EQUAL),
@@ -1395,10 +1405,7 @@ fn flat_rows_given<const N: usize, C: PixelFormat, D: DepthBuffer + ?Sized, R: R
             DepthFunc::GreaterEqual => Some(cmp::GREATER_EQUAL),
             _ => None,
         };
-        let (args, sides) = (
-            (edges, &shader.plane(), rows, base, max_n),
-            t.flat_facts & SIDES,
-        );
+        let (args, sides) = ((edges, &shader.plane(), rows, base, max_n), facts & SIDES);
         // `Less`, the default, with its test folded in; the others share
         // one copy that picks each span's loop (flash over a few
         // instructions a span).
@@ -1597,8 +1604,17 @@ fn flat_rows_in_range<
 /// is `-(y_b - y_a)` times the subpixel unit, so its side is the sign of
 /// `y_a - y_b`) in the [`SIDES`] bits, and [`Z_IN_RANGE`] where
 /// [`z_never_clamps`]. Both depend on the triangle alone, so setup finds
-/// them once a frame rather than [`flat_rows`] once a strip.
+/// them once a frame (when a [`Frame`](crate::Frame) stores the
+/// triangle) rather than [`flat_rows`] once a strip. A box narrower than
+/// [`SMALL_WIDTH`] never reaches `flat_rows` and gets 0, as do triangles
+/// set up in immediate mode (`flat_rows` finds those itself: 0 is never
+/// a pattern of sides). Spot's triangles, mostly that small and set up
+/// again every strip in immediate mode, paid 3-4 % of the M4F's frame
+/// for facts found at every setup.
 pub(crate) fn flat_facts(y: [i32; 3], z: [u32; 3], max_n: usize) -> u8 {
+    if max_n < SMALL_WIDTH as usize {
+        return 0;
+    }
     let side = |ya: i32, yb: i32| match ya.cmp(&yb) {
         core::cmp::Ordering::Greater => LEFT,
         core::cmp::Ordering::Less => RIGHT,
@@ -1611,6 +1627,22 @@ pub(crate) fn flat_facts(y: [i32; 3], z: [u32; 3], max_n: usize) -> u8 {
         } else {
             0
         }
+}
+
+/// [`flat_facts`] of a set-up triangle.
+#[inline]
+pub(crate) fn flat_facts_of<const N: usize>(t: &SetupTriangle<N>) -> u8 {
+    flat_facts(t.y, t.z, (t.max_x - t.min_x) as usize)
+}
+
+/// The triangle's flat facts: the stored ones, or (immediate mode) found
+/// now.
+#[inline(always)]
+fn facts<const N: usize>(t: &SetupTriangle<N>) -> u8 {
+    match t.flat_facts {
+        0 => flat_facts_of(t),
+        f => f,
+    }
 }
 
 /// The bits of [`flat_facts`] that hold the sides pattern.
@@ -1806,7 +1838,7 @@ mod tests {
                 prop_oneof![any::<u32>(), 0u32..1 << 16, u32::MAX - (1 << 16)..=u32::MAX],
                 prop_oneof![any::<u32>(), 0u32..1 << 16, u32::MAX - (1 << 16)..=u32::MAX],
             ],
-            max_n in 0usize..4096,
+            max_n in prop_oneof![0usize..16, 0usize..4096],
         ) {
             let snap = |v: [i32; 3]| if coarse { v.map(|c| c & !0x3ff) } else { v };
             let (x, y) = (snap(x), snap(y));
@@ -1831,10 +1863,16 @@ mod tests {
                 Edge::new::<8>(x[2], y[2], x[0], y[0], 128, 128),
                 Edge::new::<8>(x[0], y[0], x[1], y[1], 128, 128),
             ];
-            prop_assert_eq!(facts & SIDES, pattern(e32.map(|e| e.step_x as i64)));
-            prop_assert_eq!(facts & SIDES, pattern(e64.map(|e| e.step_x)));
-            prop_assert_eq!(facts & Z_IN_RANGE != 0, z_never_clamps(z, max_n));
-            prop_assert_eq!(facts & !(SIDES | Z_IN_RANGE), 0);
+            if max_n < SMALL_WIDTH as usize {
+                prop_assert_eq!(facts, 0);
+            } else {
+                // (0 is "not found": never a pattern.)
+                prop_assert_ne!(facts, 0);
+                prop_assert_eq!(facts & SIDES, pattern(e32.map(|e| e.step_x as i64)));
+                prop_assert_eq!(facts & SIDES, pattern(e64.map(|e| e.step_x)));
+                prop_assert_eq!(facts & Z_IN_RANGE != 0, z_never_clamps(z, max_n));
+                prop_assert_eq!(facts & !(SIDES | Z_IN_RANGE), 0);
+            }
         }
 
         /// `z_difference` converts the exact difference, by either route

@@ -60,8 +60,11 @@ pub struct SetupTriangle<const N: usize = 3> {
     /// frame, not once per strip; a byte the struct's padding had).
     pub(crate) edge32: bool,
     /// What its flat rows need to know of it (`raster::flat_facts`: its
-    /// edges' sides and whether its depths never clamp), once per frame,
-    /// not once per strip; another byte of the padding.
+    /// edges' sides and whether its depths never clamp), found once a
+    /// frame when a [`Frame`](crate::Frame) stores it, not once a strip;
+    /// 0 where not found (immediate mode sets a triangle up for the one
+    /// strip it draws it in, so `flat_rows` finds them itself). Another
+    /// byte of the padding.
     pub(crate) flat_facts: u8,
     /// The caller's triangle index.
     pub(crate) id: u32,
@@ -332,11 +335,7 @@ impl Geometry {
             flat,
             smooth,
             edge32: self.edge32,
-            flat_facts: crate::raster::flat_facts(
-                self.y,
-                self.z,
-                (self.bbox[1] - self.bbox[0]) as usize,
-            ),
+            flat_facts: 0,
             id,
         }
     }
