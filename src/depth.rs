@@ -192,9 +192,9 @@ pub trait DepthBuffer {
 
     /// [`flat_span_in_range`](DepthBuffer::flat_span_in_range) for a
     /// batch of spans, each `[start, length, Z32 start]` (a length may be
-    /// 0); returns the pixels it wrote. Buffers override it with one loop over the
-    /// spans (a call a span, and the arguments it takes, were a third of
-    /// a small span's instructions on the Cortex-M4F).
+    /// 0); returns the pixels it wrote. Buffers override it with one loop
+    /// over the spans (a call a span, and the arguments it takes, were a
+    /// third of a small span's instructions on the Cortex-M4F).
     #[doc(hidden)]
     #[inline(always)]
     fn flat_spans_in_range<C: Copy>(

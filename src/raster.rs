@@ -1738,6 +1738,15 @@ fn batch_spans<R: Real, T: EdgeInt, const SIDES: u8>(
                 _ => {}
             }
         }
+        // An empty row's depth start is computed too, and not used: every
+        // row lies in the vertices' vertical extent, where the triangle's
+        // slice is an interval (maybe pixel-free) within their horizontal
+        // extent, so `lo` is at most one column past the vertices' box
+        // (past `max_n` where the box is clamped to the frame), where the
+        // edge values and `step_x * lo` still fit `i32` (`EDGE32_SPAN`:
+        // at most 177 columns of steps below 11,520,000). The tests'
+        // overflow checks exercise it (`tests/lazy_clear.rs` draws rows
+        // with `lo` beyond `max_n + 1`).
         let z0 = plane.z_at(e[1] + step_x(1) * lo, e[2] + step_x(2) * lo);
         let start = row.wrapping_add(lo.widen() as usize) as u32;
         let len = if lo <= hi {

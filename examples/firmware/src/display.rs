@@ -6,11 +6,11 @@
 //! each strip must cover full rows and continue where the last one stopped
 //! (anything else is an error, which the strip drawer hands back), and its
 //! pixels go, two to a 32-bit word as a DMA transfer packs them, into a
-//! checksum
-//! (`microraster_scenes::checksum`: two additions a word, eight words a
-//! loop turn) instead of onto the wire. The checksum of a frame does not depend on how it was cut
-//! into strips (rows are an even number of pixels wide). The instructions
-//! it spends are counted apart, on their own line.
+//! checksum (`microraster_scenes::checksum`: two additions a word, eight
+//! words a loop turn) instead of onto the wire. The checksum of a frame
+//! does not depend on how it was cut into strips (rows are an even number
+//! of pixels wide). The instructions it spends are counted apart, on
+//! their own line.
 //!
 //! With the `tiles` feature it stands in for a display that takes
 //! windowed writes instead: any rectangle inside the frame (an even
