@@ -1135,6 +1135,14 @@ fn edge32_limit_tri() -> impl Strategy<Value = [SubPt; 3]> {
 fn check_depth_coverage<const S: u32>(config: Config, pos: [Vec4; 3]) -> Result<(), TestCaseError> {
     let n = (config.width * config.height) as usize;
     let plain = coverage::<S>(config, pos);
+    // Depths kept off the planes (NDC within 0.999 of them; the same
+    // coverage, as nothing is clipped either way): a `u16` depth of 0
+    // never passes `Greater` against a clear of 0, nor 0xFFFF `Less`
+    // against 0xFFFF, so a triangle at NDC depth below -1 + 3e-5 drew
+    // nothing there (found by CI's 100,000-case run). The planes
+    // themselves are `unchecked_u16_spans_equal_the_clamped_path`'s and
+    // `u16_spans_with_vertices_on_the_planes_at_pixel_centres`'.
+    let pos = pos.map(|p| Vec4::new(p.x, p.y, p.z * 0.999, p.w));
     let (ids16, ids32) = with_frame::<S, _>(config, &[pos], |frame| {
         let mut ids16 = vec![TriangleId(0); n];
         let mut z16 = vec![u16::MAX; n];
@@ -1455,4 +1463,24 @@ fn horizontal_edges_through_pixel_centres_match_the_reference() {
             }
         }
     }
+}
+
+/// The two triangles CI's 100,000-case run found: every depth within
+/// 3e-5 of the near plane (a `u16` depth of 0), drawn by
+/// `check_depth_coverage` (which keeps depths off the planes since).
+#[test]
+fn depth_coverage_of_triangles_at_the_near_plane() {
+    let v = |x: f32, y: f32, z: f32| Vec4::new(x, y, z, 1.0);
+    let a = [
+        v(0.0, 0.0, -0.99998105),
+        v(0.0, -0.08976485, -0.99998105),
+        v(0.08686292, 0.0, -0.99998105),
+    ];
+    check_depth_coverage::<4>(config_nocull(27, 36), a).unwrap();
+    let b = [
+        v(0.0, -79514.055, 0.0),
+        v(313054.8, 0.0, 0.0),
+        v(0.0, 0.0, -0.9999949),
+    ];
+    check_depth_coverage::<8>(config_nocull(1, 7), b).unwrap();
 }
