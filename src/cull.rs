@@ -657,6 +657,9 @@ pub struct Eye {
     /// The frame, for the size guard ([`Eye::for_frame`]); `None` for a
     /// geometric eye ([`Eye::from_mvp`], [`Eye::at`]).
     pub(crate) screen: Option<Screen>,
+    /// The size guard of a ball around every node tested
+    /// ([`Eye::within`]), tried before a node's own.
+    outer: Option<WindingFloor>,
 }
 
 /// The rows `x`, `y`, `w` of a model-view-projection matrix as linear
@@ -665,7 +668,7 @@ pub struct Eye {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Projection {
     /// Rows `x`, `y`, `w`.
-    rows: [([f32; 4], f32); 3],
+    rows: [Form; 3],
     /// `W / 2`, `H / 2`.
     half: [f32; 2],
 }
@@ -676,15 +679,14 @@ struct Projection {
 pub(crate) struct Screen {
     view: Projection,
     /// Near, far and the four guard-band planes.
-    planes: [([f32; 4], f32); 6],
+    planes: [Form; 6],
     /// Half a subpixel, pixels.
     snap: f32,
 }
 
 /// [`Projection::reach`]: over a ball, the least and greatest `w`, bounds
 /// on `|x/w|` and `|y/w|`, the most pixels per object length (`m`; `axis`
-/// for the pixel `x` and `y` alone), and `|origin|_1 + radius + 1` (for
-/// rounding bounds).
+/// for the pixel `x` and `y` alone).
 struct Reach {
     w_min: f32,
     w_max: f32,
@@ -692,7 +694,6 @@ struct Reach {
     gy: f32,
     m: f32,
     axis: [f32; 2],
-    c1: f32,
 }
 
 impl Eye {
@@ -742,6 +743,7 @@ impl Eye {
             point,
             big: big as f32,
             screen: None,
+            outer: None,
         })
     }
 
@@ -761,52 +763,110 @@ impl Eye {
         e.screen = Some(screen);
         Some(e)
     }
+
+    /// This eye with the size guard of the ball `sphere` found once, for
+    /// a frame's eye ([`Eye::for_frame`]; others are returned as they
+    /// are): a back-facing node is then first tried against that ball,
+    /// and its own sphere's guard is found only where the ball's fails.
+    /// Any ball around a node's triangles bounds what the guard needs of
+    /// them (their `w`, pixels per object length and rounding), so a node
+    /// it passes passes with its own sphere, and the decisions are at
+    /// least those without it: for a `sphere` around every vertex of the
+    /// nodes tested (a mesh's bounding sphere, as
+    /// [`Submit::submit_clusters`](crate::Submit::submit_clusters) passes
+    /// its mesh's bounds) the frame is still the per-triangle one. The
+    /// guard of each back-facing node is most of the cost of a tree walk;
+    /// this is a few multiplications instead where the ball is not much
+    /// larger than the mesh on screen.
+    pub fn within(mut self, sphere: &BoundingSphere) -> Eye {
+        let c = [sphere.center.x, sphere.center.y, sphere.center.z];
+        if let Some(sc) = &self.screen {
+            self.outer = sc.winding_floor(c, sphere.radius, self.big);
+        }
+        self
+    }
 }
 
-/// A linear form with `|l_xyz|`.
-fn with_norm(l: [f32; 4]) -> ([f32; 4], f32) {
-    (
-        l,
-        crate::math::fx::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]),
-    )
+/// A linear form on `(p, 1)` with `|l_xyz|` and `|l|_1`, both found once
+/// a frame (the size guard of every node uses them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Form {
+    l: [f32; 4],
+    /// `|l_xyz|`.
+    n: f32,
+    /// `|l|_1`.
+    l1: f32,
 }
 
-/// Whether a form and its norm are finite.
-fn finite_form((l, n): &([f32; 4], f32)) -> bool {
-    l.iter().all(|v| v.is_finite()) && n.is_finite()
+impl Form {
+    fn new(l: [f32; 4]) -> Form {
+        Form {
+            l,
+            n: crate::math::fx::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]),
+            l1: l.iter().map(|v| v.abs()).sum::<f32>(),
+        }
+    }
+
+    /// Whether the form and its norm are finite.
+    fn finite(&self) -> bool {
+        self.l.iter().all(|v| v.is_finite()) && self.n.is_finite()
+    }
+
+    /// Its value at `p`.
+    fn at(&self, p: [f32; 3]) -> f32 {
+        let l = &self.l;
+        l[0] * p[0] + l[1] * p[1] + l[2] * p[2] + l[3]
+    }
+
+    /// How far it can range from its value at the centre over a ball of
+    /// `radius`, with the `f32` rounding of its evaluation (`c1`:
+    /// `|origin|_1 + radius + 1`).
+    fn spread(&self, radius: f32, c1: f32) -> f32 {
+        self.n * radius * (1.0 + ROUNDING) + ROUNDING * self.l1 * c1
+    }
+}
+
+/// `|origin|_1 + radius + 1`: a bound on `|(p, 1)|_inf` over the ball, for
+/// rounding bounds.
+fn ball_c1(origin: [f32; 3], radius: f32) -> f32 {
+    origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0
 }
 
 impl Projection {
     /// The projection of a frame of `config` drawn with `mvp`; `None` for
-    /// a non-finite matrix.
+    /// a non-finite matrix. Not inlined: [`Detail::for_frame`] is inlined
+    /// into every submission, where detail culling is mostly off.
+    #[inline(never)]
     fn new(mvp: &Mat4, config: &crate::Config) -> Option<Projection> {
         let c = &mvp.cols;
         let row = |i: usize| [c[0][i], c[1][i], c[2][i], c[3][i]];
         let view = Projection {
-            rows: [row(0), row(1), row(3)].map(with_norm),
+            rows: [row(0), row(1), row(3)].map(Form::new),
             half: [config.width as f32 * 0.5, config.height as f32 * 0.5],
         };
-        view.rows.iter().all(finite_form).then_some(view)
+        view.rows.iter().all(Form::finite).then_some(view)
     }
 
     /// How the projection behaves over the ball of `radius` around
     /// `origin` (object units), with the `f32` rounding of these bounds
     /// allowed for; `None` unless the whole ball has `w > 0`.
     fn reach(&self, origin: [f32; 3], radius: f32) -> Option<Reach> {
-        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
-        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
-        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+        self.reach_c1(origin, radius, ball_c1(origin, radius))
+    }
+
+    /// [`Projection::reach`] with `c1` ([`ball_c1`]) found by the caller.
+    fn reach_c1(&self, origin: [f32; 3], radius: f32, c1: f32) -> Option<Reach> {
         // A form's range over the ball: centre value +- spread.
-        let spread = |l: &[f32; 4], n: f32| n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1;
-        let [(rx, nx), (ry, ny), (rw, nw)] = &self.rows;
-        let (wc, wr) = (at(rw), spread(rw, *nw));
+        let [rx, ry, rw] = &self.rows;
+        let (nx, ny, nw) = (rx.n, ry.n, rw.n);
+        let (wc, wr) = (rw.at(origin), rw.spread(radius, c1));
         let (w_min, w_max) = (wc - wr, wc + wr);
         if !(w_min > 0.0) {
             return None;
         }
         // |x/w| and |y/w| over the ball.
-        let gx = (at(rx).abs() + spread(rx, *nx)) / w_min;
-        let gy = (at(ry).abs() + spread(ry, *ny)) / w_min;
+        let gx = (rx.at(origin).abs() + rx.spread(radius, c1)) / w_min;
+        let gy = (ry.at(origin).abs() + ry.spread(radius, c1)) / w_min;
         let [hw, hh] = self.half;
         let (mx, my) = (hw * (nx + gx * nw), hh * (ny + gy * nw));
         let m = crate::math::fx::sqrt(mx * mx + my * my) * (1.0 + ROUNDING) / w_min;
@@ -818,7 +878,6 @@ impl Projection {
             gy,
             m,
             axis,
-            c1,
         })
     }
 }
@@ -843,24 +902,21 @@ impl Screen {
             comb(rw, gy, ry, -1.0),
             comb(rw, gy, ry, 1.0),
         ]
-        .map(with_norm);
+        .map(Form::new);
         let screen = Screen {
             view,
             planes,
             snap: 1.0 / (1u32 << (S + 1)) as f32,
         };
-        screen.planes.iter().all(finite_form).then_some(screen)
+        screen.planes.iter().all(Form::finite).then_some(screen)
     }
 
     /// Whether the ball of `radius` around `origin` lies inside near, far
-    /// and the guard band.
-    fn contains(&self, origin: [f32; 3], radius: f32) -> bool {
-        let at = |l: &[f32; 4]| l[0] * origin[0] + l[1] * origin[1] + l[2] * origin[2] + l[3];
-        let c1 = origin.iter().map(|v| v.abs()).sum::<f32>() + radius + 1.0;
-        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+    /// and the guard band (`c1`: [`ball_c1`]).
+    fn contains_c1(&self, origin: [f32; 3], radius: f32, c1: f32) -> bool {
         self.planes
             .iter()
-            .all(|(l, n)| at(l) > n * radius * (1.0 + ROUNDING) + ROUNDING * l1(l) * c1)
+            .all(|p| p.at(origin) > p.spread(radius, c1))
     }
 
     /// Whether every triangle of a node (within `radius` of `origin`;
@@ -900,7 +956,8 @@ impl Screen {
         radius: f32,
         big: f32,
     ) -> Option<WindingFloor> {
-        if !self.contains(origin, radius) {
+        let c1 = ball_c1(origin, radius);
+        if !self.contains_c1(origin, radius, c1) {
             return None;
         }
         let Reach {
@@ -909,12 +966,11 @@ impl Screen {
             gx,
             gy,
             m,
-            c1,
             ..
-        } = self.view.reach(origin, radius)?;
+        } = self.view.reach_c1(origin, radius, c1)?;
         let [hw, hh] = self.view.half;
-        let [(rx, _), (ry, _), (rw, _)] = &self.view.rows;
-        let l1 = |l: &[f32; 4]| l.iter().map(|v| v.abs()).sum::<f32>();
+        let [rx, ry, rw] = &self.view.rows;
+        let l1 = |f: &Form| f.l1;
         // Rounding: the transform (3 roundings a row, 2^-22 relative to
         // |row|_1 |(p, 1)|_inf, through the division by w) and NDC to
         // pixels (a few ulps of the pixel coordinate).
@@ -978,6 +1034,7 @@ impl Eye {
             point: Some(p),
             big: 1.0,
             screen: None,
+            outer: None,
         })
     }
 }
@@ -997,6 +1054,9 @@ impl ClusterNode {
         };
         match (f, &e.screen) {
             (Facing::Back, Some(sc)) => {
+                if e.outer.is_some_and(|f| f.keeps(self.size, phi)) {
+                    return Facing::Back;
+                }
                 let b = &self.sphere;
                 let centre = [b.center.x, b.center.y, b.center.z];
                 let sized = sc.keeps_winding(centre, b.radius, self.size, phi, e.big);

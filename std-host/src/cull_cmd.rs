@@ -323,6 +323,10 @@ fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
         return case.mesh.positions.len();
     };
     let eye = Eye::for_frame::<8>(mvp, &case.config);
+    let eye = match &case.mesh.bounds {
+        Some(b) => eye.map(|e| e.within(b)),
+        None => eye,
+    };
     let detail = Detail::for_frame(mvp, &case.config);
     let mut seen = vec![false; c.positions.len()];
     let mut n = 0;
@@ -369,13 +373,13 @@ fn measure(
         positions,
         indices,
         attributes: MeshColors::PerTriangle(&src_colors),
-        bounds: None,
+        bounds: BoundingSphere::from_points(positions),
     };
     let cmesh = Mesh {
         positions: &clustered.positions,
         indices: &clustered.indices,
         attributes: MeshColors::PerTriangle(&colors),
-        bounds: None,
+        bounds: BoundingSphere::from_points(&clustered.positions),
     };
     // Lossy rows are set against this mesh (in one colour, so a box in
     // that colour is right where it covers the mesh).

@@ -6,8 +6,8 @@
 
 use microraster::prelude::*;
 use microraster::{
-    ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors, ProcessedVertex,
-    SetupTriangle, Stats,
+    BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
+    ProcessedVertex, SetupTriangle, Stats,
 };
 mod common;
 
@@ -23,11 +23,14 @@ fn camera(m: &ClusteredMesh, dir: [f32; 3], dist: f32, jitter: [f32; 3]) -> Opti
     common::camera(m, dir, dist, jitter, 20.0, W as f32 / H as f32)
 }
 
-/// Colour and depth of the mesh drawn with `cull` (`None`: per triangle).
+/// Colour and depth of the mesh drawn with `cull` (`None`: per triangle),
+/// with the mesh's bounding sphere where `bounded` (which the cluster
+/// tests then try first: `Eye::within`).
 fn draw<const S: u32>(
     m: &ClusteredMesh,
     mvp: &Mat4,
     cull: Option<ClusterCull>,
+    bounded: bool,
 ) -> (Vec<u8>, Stats) {
     let colors: Vec<Rgb888> = (0..m.indices.len())
         .map(|i| Rgb888::new((i * 37) as u8, (i * 91) as u8, (i * 13) as u8))
@@ -36,7 +39,9 @@ fn draw<const S: u32>(
         positions: &m.positions,
         indices: &m.indices,
         attributes: MeshColors::PerTriangle(&colors),
-        bounds: None,
+        bounds: bounded
+            .then(|| BoundingSphere::from_points(&m.positions))
+            .flatten(),
     };
     let mut storage = vec![SetupTriangle::EMPTY; m.indices.len() + 64];
     let mut frame = Frame::<S>::with_subpixel_bits(Config::new(W, H), &mut storage).unwrap();
@@ -90,10 +95,10 @@ fn differing(a: &[u8], b: &[u8]) -> usize {
 /// method: the same pieces are set up (the size guard skips only
 /// triangles the per-triangle path drops), so the frame is byte-identical,
 /// and every triangle is counted once.
-fn check<const S: u32>(m: &ClusteredMesh, mvp: &Mat4) -> [(u64, usize); 4] {
-    let (want, base) = draw::<S>(m, mvp, None);
+fn check<const S: u32>(m: &ClusteredMesh, mvp: &Mat4, bounded: bool) -> [(u64, usize); 4] {
+    let (want, base) = draw::<S>(m, mvp, None, bounded);
     METHODS.map(|c| {
-        let (got, stats) = draw::<S>(m, mvp, Some(c));
+        let (got, stats) = draw::<S>(m, mvp, Some(c), bounded);
         let skipped = stats.culled_cluster + stats.culled_hierarchy;
         assert_eq!(stats.submitted, base.submitted);
         assert_eq!(stats.stored, base.stored, "{c:?} set up other pieces");
@@ -115,10 +120,11 @@ proptest! {
         dist in 1.2f32..6.0,
         jitter in prop::array::uniform3(-0.5f32..0.5),
         fine in any::<bool>(),
+        bounded in any::<bool>(),
     ) {
         let m = &models()[which];
         if let Some(mvp) = camera(m, dir, dist, jitter) {
-            if fine { check::<8>(m, &mvp); } else { check::<4>(m, &mvp); }
+            if fine { check::<8>(m, &mvp, bounded); } else { check::<4>(m, &mvp, bounded); }
         }
     }
 }
@@ -133,10 +139,14 @@ fn every_method_culls_a_share_of_each_mesh_from_64_cameras() {
             let r = (1.0 - y * y).sqrt();
             let phi = i as f32 * 2.399_963;
             let mvp = camera(m, [r * phi.cos(), y, r * phi.sin()], 2.5, [0.0; 3]).unwrap();
-            let r = check::<8>(m, &mvp);
+            let r = check::<8>(m, &mvp, false);
+            // With the mesh's sphere tried first, every node culled
+            // without it is culled still (and a few more may be).
+            let within = check::<8>(m, &mvp, true);
             for k in 0..4 {
                 total[k] += r[k].0;
                 assert_eq!(r[k].1, 0, "frames differ from 2.5 radii");
+                assert!(within[k].0 >= r[k].0, "{:?} culled less", METHODS[k]);
             }
         }
         let n = (m.indices.len() * 64) as f64;
@@ -210,6 +220,8 @@ fn far_subpixel_triangles_that_snapping_flips() {
         [0.042_000_853, 0.098_053_604, -0.202_792_33],
     )
     .unwrap();
-    let r = check::<4>(m, &mvp);
-    assert_eq!(r.map(|x| x.1), [0; 4]);
+    for bounded in [false, true] {
+        let r = check::<4>(m, &mvp, bounded);
+        assert_eq!(r.map(|x| x.1), [0; 4]);
+    }
 }

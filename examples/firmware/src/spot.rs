@@ -163,10 +163,12 @@ fn cluster_set() -> ClusterSet<'static> {
 }
 
 /// The eye the cluster tests use this frame (`Eye::for_frame`, with the
-/// size guard): `None` draws every cluster.
+/// size guard, tried first over the whole mesh's sphere: `Eye::within`):
+/// `None` draws every cluster.
 #[cfg(feature = "clusters")]
 fn cluster_eye(mvp: &Mat4, config: &Config) -> Option<Eye> {
     CULL.and_then(|_| Eye::for_frame::<8>(mvp, config))
+        .map(|e| e.within(&chunks::WHOLE_SPHERE))
 }
 
 /// What the frame's cluster test decided, once for all strips: a bit per
