@@ -2,7 +2,9 @@
 //! small mesh, a cluster set that is either built honestly from it
 //! (`CullVolume::from_triangles`, `NormalCone::from_triangles`, a pairwise
 //! tree) or arbitrary (bad ranges, trees that do not tile, NaN and huge
-//! geometry), an arbitrary matrix and cull settings.
+//! geometry), an arbitrary matrix and cull settings, and the mesh's
+//! bounds (none, its true sphere, or any floats), which object culling
+//! and the clusters' whole-mesh size guard (`Eye::within`) use.
 //!
 //! Checks: no panic; `validate` refuses exactly what `submit_clusters`
 //! refuses, and a refused or failed submission writes no counter and no
@@ -78,6 +80,11 @@ pub struct ClusterInput {
     raw_classes: Vec<u16>,
     raw_sizes: Vec<[F; 2]>,
     raw_spheres: Vec<[F; 4]>,
+    /// The mesh's bounds, which the cluster tests try first
+    /// (`Eye::within`): 0 none, 1 the true sphere of the positions, else
+    /// `raw_bounds` (any floats: then frames may lose pieces, never gain).
+    bounds: u8,
+    raw_bounds: [F; 4],
 }
 
 fn node_from(n: &NodeIn) -> ClusterNode {
@@ -260,7 +267,17 @@ pub fn run_clusters(input: &ClusterInput) {
         positions: &p,
         indices: &t,
         attributes: MeshColors::PerTriangle(&colors),
-        bounds: None,
+        bounds: match input.bounds % 3 {
+            0 => None,
+            1 => BoundingSphere::from_points(&p),
+            _ => {
+                let b = input.raw_bounds.map(|f| f.0);
+                Some(BoundingSphere {
+                    center: Vec3::new(b[0], b[1], b[2]),
+                    radius: b[3],
+                })
+            }
+        },
     };
     let mut config = Config::new(64, 48);
     config.cull = [CullMode::Back, CullMode::Front, CullMode::None][usize::from(input.cull % 3)];
@@ -344,7 +361,7 @@ pub fn run_clusters(input: &ClusterInput) {
                 attributes: mesh.attributes,
                 fill: fill.map(|f| f.0),
             },
-            bounds: None,
+            bounds: mesh.bounds,
         };
         // Without a fill, with room for everything.
         let mut st_plain = vec![SetupTriangle::EMPTY; t.len() * 7 + 1];
@@ -526,7 +543,16 @@ fn run_masks(
         }
         (r, v) => panic!("submit_masked {r:?} but validate {v:?}"),
     }
-    run_mesh_masked(mesh, mvp, config, reference, &frame, &set, room, honest && valid.is_ok());
+    run_mesh_masked(
+        mesh,
+        mvp,
+        config,
+        reference,
+        &frame,
+        &set,
+        room,
+        honest && valid.is_ok(),
+    );
 }
 
 /// `submit_mesh_masked` with the frame's own `back_mask` (no vertex cache,
@@ -572,7 +598,11 @@ fn run_mesh_masked(
                 assert_eq!(after, reference.stats(), "nothing masked");
                 assert_eq!(frame.triangles(), reference.triangles());
             } else if honest && masked.stats().submitted == t as u64 {
-                assert_eq!(frame.triangles(), masked.triangles(), "not submit_masked's pieces");
+                assert_eq!(
+                    frame.triangles(),
+                    masked.triangles(),
+                    "not submit_masked's pieces"
+                );
             }
         }
         Err(e) => panic!("submit_mesh_masked: {e:?}"),
