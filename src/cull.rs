@@ -970,11 +970,10 @@ impl Screen {
         } = self.view.reach_c1(origin, radius, c1)?;
         let [hw, hh] = self.view.half;
         let [rx, ry, rw] = &self.view.rows;
-        let l1 = |f: &Form| f.l1;
         // Rounding: the transform (3 roundings a row, 2^-22 relative to
         // |row|_1 |(p, 1)|_inf, through the division by w) and NDC to
         // pixels (a few ulps of the pixel coordinate).
-        let transform = (hw * (l1(rx) + gx * l1(rw)) + hh * (l1(ry) + gy * l1(rw))) * c1 / w_min;
+        let transform = (hw * (rx.l1 + gx * rw.l1) + hh * (ry.l1 + gy * rw.l1)) * c1 / w_min;
         let pixels = hw * (1.0 + gx) + hh * (1.0 + gy);
         let rho = self.snap + (transform + pixels) / 1_048_576.0;
         Some(WindingFloor {

@@ -315,10 +315,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             RasterMode::Clipping => Eye::for_frame::<S>(mvp, &self.stage().config),
             RasterMode::Clipless => None,
         };
-        let eye = match mesh.bounds {
-            Some(b) => eye.map(|e| e.within(&b)),
-            None => eye,
-        };
+        let eye = eye.map(|e| mesh.bounds.map_or(e, |b| e.within(&b)));
         let detail = Detail::for_frame(mvp, &self.stage().config);
         let list = set.vertices;
         let drawn = |f: &mut dyn FnMut(&Cluster)| {

@@ -323,10 +323,7 @@ fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
         return case.mesh.positions.len();
     };
     let eye = Eye::for_frame::<8>(mvp, &case.config);
-    let eye = match &case.mesh.bounds {
-        Some(b) => eye.map(|e| e.within(b)),
-        None => eye,
-    };
+    let eye = eye.map(|e| case.mesh.bounds.map_or(e, |b| e.within(&b)));
     let detail = Detail::for_frame(mvp, &case.config);
     let mut seen = vec![false; c.positions.len()];
     let mut n = 0;
