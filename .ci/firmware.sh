@@ -19,6 +19,10 @@
 # the M4F and the M0 (subpixel bits, depth buffer, float backend, the i32
 # edge fast path: the speed axis of `microraster report speed-vs-error`),
 # with its own table of record.
+#
+# The builds and QEMU runs go first, FIRMWARE_JOBS at once (default: one
+# a core, at most 4), each worker in a target dir of its own; the checks
+# then read their outputs in order. FIRMWARE_JOBS=1 runs them one by one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -57,30 +61,44 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
 (
   cd examples/firmware
   cargo fmt --check
-  for target in thumbv7em-none-eabihf thumbv6m-none-eabi; do
-    cargo clippy -q --release --target "$target" -- -D warnings
-    cargo clippy -q --release --target "$target" --features no-depth,flat -- -D warnings
-    cargo clippy -q --release --target "$target" --features immediate -- -D warnings
-    cargo clippy -q --release --target "$target" --features clipless -- -D warnings
-    cargo clippy -q --release --target "$target" --features tiles,inv-w -- -D warnings
-    cargo clippy -q --release --target "$target" --features clipless,inv-w -- -D warnings
-    cargo clippy -q --release --target "$target" --features subpixel4,depth-u32,no-i32-edges -- -D warnings
-    cargo clippy -q --release --target "$target" --no-default-features --features micromath -- -D warnings
+  lint() { # TARGET [CARGO ARGS...]: one build's clippy, warnings denied
+    local t=$1
+    shift
+    cargo clippy -q --release --target "$t" "$@" -- -D warnings
+  }
+  lint_board() { # TARGET: the builds every board has
+    lint "$1"
+    lint "$1" --features no-depth,flat
+    lint "$1" --features immediate
+    lint "$1" --features clipless
+    lint "$1" --features tiles,inv-w
+    lint "$1" --features clipless,inv-w
+    lint "$1" --features subpixel4,depth-u32,no-i32-edges
+    lint "$1" --no-default-features --features micromath
     for v in spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong; do
-      cargo clippy -q --release --target "$target" --features "$v" -- -D warnings
+      lint "$1" --features "$v"
     done
-  done
-  # Cluster culling of Spot: the MPS2 boards only (all of Spot).
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-volumes -- -D warnings
-  # Normal masks of Spot, likewise.
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,cull-masks -- -D warnings
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,cull-masks-frame -- -D warnings
-  # The herd of Spots, with and without occlusion culling, likewise.
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-flat,herd -- -D warnings
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features spot-lit,herd-occlusion -- -D warnings
-  # The house, with and without portal culling, likewise.
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features house -- -D warnings
-  cargo clippy -q --release --target thumbv7em-none-eabihf --features house-portals -- -D warnings
+  }
+  # Two lists at once, the second with a target dir of its own: checking
+  # the core is one rustc process, so one list leaves a core idle.
+  (
+    export CARGO_TARGET_DIR=target/lint-b
+    lint_board thumbv6m-none-eabi
+    # The herd of Spots, with and without occlusion culling, and the
+    # house, with and without portal culling: the MPS2 boards only.
+    lint thumbv7em-none-eabihf --features spot-flat,herd
+    lint thumbv7em-none-eabihf --features spot-lit,herd-occlusion
+    lint thumbv7em-none-eabihf --features house
+    lint thumbv7em-none-eabihf --features house-portals
+  ) &
+  second=$!
+  lint_board thumbv7em-none-eabihf
+  # Cluster culling and normal masks of Spot: the MPS2 boards only (all
+  # of Spot).
+  lint thumbv7em-none-eabihf --features spot-lit,cull-volumes
+  lint thumbv7em-none-eabihf --features spot-lit,cull-masks
+  lint thumbv7em-none-eabihf --features spot-flat,cull-masks-frame
+  wait "$second"
 )
 
 expected() { awk -v k="$1" '$1 == k { print $2 }' "$root/examples/firmware/host-checksums.txt"; }
@@ -97,6 +115,13 @@ variants=("" "flat" "no-depth" "no-depth,flat" "immediate")
 # Spot (baked, immediate mode), one shading variant each; the micro:bit
 # draws the decimated bake, so its checksums have keys of their own.
 spot_variants=(spot-flat spot-gouraud spot-lit spot-textured spot-textured-lit spot-phong)
+# Spot in cluster order with the cluster tests (docs/culling.md), with normal
+# masks, the herd with and without occlusion culling, and the house with
+# and without portal culling: the M4F only.
+cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
+mask_variants=(spot-flat,cull-masks spot-flat,cull-masks-frame spot-lit,cull-masks spot-lit,cull-masks-frame)
+herd_variants=(spot-flat,herd spot-flat,herd-occlusion)
+house_variants=(house house-portals)
 table_header="| board | features | flash B | statics B | stack B | RAM B | pixels written | instructions/frame | display push | render | clears | geometry (all strips) | rasterization | render instr/px |"
 # Columns 8-13 of the table (frame, display push, render, clears,
 # geometry, rasterization) are the instruction counts of record.
@@ -179,12 +204,12 @@ shade_fns() {
       /microraster::shade::(Texture|Textured|ColorUv|Phong<microraster::shade::Texture)/ { print "texture", $0 }'
 }
 
-# check_linked BOARD VARIANT ELF: an unlit variant links no lighting code
+# check_linked BOARD VARIANT FNS: an unlit variant links no lighting code
 # and an untextured one no texture code (and the others do, so the check
-# is not vacuous).
+# is not vacuous); FNS is the file of the ELF's shade_fns.
 check_linked() {
-  local board=$1 v=$2 elf=$3 fns lit tex
-  fns=$(shade_fns "$elf")
+  local board=$1 v=$2 fns lit tex
+  fns=$(cat "$3")
   lit=$(grep -c '^lighting' <<<"$fns" || true)
   tex=$(grep -c '^texture' <<<"$fns" || true)
   case $v in spot-lit | spot-textured-lit | spot-phong) want_lit=1 ;; *) want_lit=0 ;; esac
@@ -202,10 +227,100 @@ check_linked() {
   fi
 }
 
+config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
+configs=(
+  "S8 u16 libm||depth-u16|default"
+  "S4 u16 libm|--features subpixel4|cubes-s4|"
+  "S8 u32 libm|--features depth-u32|cubes-u32|"
+  "S8 none libm|--features no-depth|no-depth|no-depth"
+  "S4 u32 libm|--features subpixel4,depth-u32|cubes-s4-u32|"
+  "S8 u16 micromath|--no-default-features --features micromath|cubes-micromath|"
+  "S4 u16 micromath|--no-default-features --features micromath,subpixel4|cubes-s4-micromath|"
+  "S8 u32 micromath|--no-default-features --features micromath,depth-u32|cubes-u32-micromath|"
+  "S4 u32 micromath|--no-default-features --features micromath,subpixel4,depth-u32|cubes-s4-u32-micromath|"
+  "S8 u16 libm no-i32-edges|--features no-i32-edges|depth-u16|"
+  "S8 u16 libm inv-w|--features inv-w|inv-w|"
+  "S8 u16 libm tiles 32x32|--features tiles|depth-u16|"
+)
+
 log=$root/target/firmware
 mkdir -p "$log"
 rows=()
 failed=0
+
+# Every build and QEMU run first, FIRMWARE_JOBS at once (default: the
+# cores, at most 4): a build's LTO and codegen (one codegen unit) and a
+# QEMU run each use one core. Each worker builds in a target dir of its
+# own and stores what the checks below read: the run's output `$out`, its
+# exit code `$out.rc`, the ELF's `arm-none-eabi-size` line `$out.size`
+# and, for Spot's shading variants, its shading functions `$out.fns`. The
+# checks then go through the runs in order. Instruction counts do not
+# depend on the host's load (-icount shift=0).
+jobs_list=$log/jobs.txt
+: >"$jobs_list"
+add_job() { # TARGET OUT "CARGO ARGS" [fns]
+  printf '%s|%s|%s|%s\n' "$1" "$2" "$3" "${4:-}" >>"$jobs_list"
+}
+for b in "${boards[@]}"; do
+  read -r target board <<<"$b"
+  for features in "${variants[@]}"; do
+    name=${features:-default}
+    add_job "$target" "$log/$board-${name//,/+}.txt" "${features:+--features $features}"
+  done
+done
+for b in "${config_boards[@]}"; do
+  read -r target board <<<"$b"
+  for c in "${configs[@]}"; do
+    IFS='|' read -r label args key reuse <<<"$c"
+    [ -n "$reuse" ] || add_job "$target" "$log/$board-config-${label// /-}.txt" "$args"
+  done
+  add_job "$target" "$log/$board-clipless.txt" "--features clipless"
+done
+for b in "${boards[@]}"; do
+  read -r target board <<<"$b"
+  for v in "${spot_variants[@]}"; do
+    add_job "$target" "$log/$board-$v.txt" "--features $v" fns
+  done
+done
+for v in "${cluster_variants[@]}" "${mask_variants[@]}" "${herd_variants[@]}" "${house_variants[@]}"; do
+  add_job thumbv7em-none-eabihf "$log/mps2-an386-${v//,/+}.txt" "--features $v"
+done
+rm -f "$log/queue.next" "$log"/*.rc "$log"/*.size "$log"/*.fns
+echo 1 >"$log/queue.next"
+# The documented command (`cargo run --release --target T --features F`);
+# the runner in .cargo/config.toml starts QEMU under `timeout 300`, and
+# the outer timeout covers the build too.
+fw_worker() { # WORKER: takes the next job of the list until none is left
+  local dir=$root/examples/firmware/target/w$1 n line target out args fns rc elf
+  while :; do
+    n=$(flock "$log/queue.lock" bash -c 'n=$(cat "$1"); echo $((n + 1)) >"$1"; echo "$n"' _ "$log/queue.next")
+    line=$(sed -n "${n}p" "$jobs_list")
+    [ -n "$line" ] || return 0
+    IFS='|' read -r target out args fns <<<"$line"
+    # shellcheck disable=SC2086 # $args is a list of cargo arguments
+    (cd "$root/examples/firmware" && CARGO_TARGET_DIR=$dir timeout 900 \
+      cargo run -q --release --target "$target" $args </dev/null >"$out" 2>&1)
+    rc=$?
+    elf=$dir/$target/release/microraster-firmware
+    if [ "$rc" = 0 ]; then
+      arm-none-eabi-size "$elf" | tail -1 >"$out.size"
+      [ -z "$fns" ] || shade_fns "$elf" >"$out.fns"
+    fi
+    echo "$rc" >"$out.rc"
+  done
+}
+workers=${FIRMWARE_JOBS:-$(nproc)}
+[ "$workers" -le 4 ] || workers=4
+step "building and running $(wc -l <"$jobs_list") firmware builds, $workers at once"
+pids=()
+for ((w = 0; w < workers; w++)); do
+  (set +e; fw_worker "$w") &
+  pids+=($!)
+done
+for p in "${pids[@]}"; do wait "$p"; done
+echo "done in ${SECONDS}s"
+# The exit code of the run whose output is `$1` ("missing": none ran).
+ran() { cat "$1.rc" 2>/dev/null || echo missing; }
 
 cd examples/firmware
 for b in "${boards[@]}"; do
@@ -214,15 +329,9 @@ for b in "${boards[@]}"; do
     name=${features:-default}
     step "$board ($target), features: $name"
     out=$log/$board-${name//,/+}.txt
-    # The documented command; the runner in .cargo/config.toml starts QEMU
-    # under `timeout 300`, and this outer timeout covers the build too.
-    set +e
-    timeout 900 cargo run -q --release --target "$target" --features "$features" </dev/null >"$out" 2>&1
-    rc=$?
-    set -e
+    rc=$(ran "$out")
     cat "$out"
-    elf=target/$target/release/microraster-firmware
-    if [ "$rc" -ne 0 ]; then
+    if [ "$rc" != 0 ]; then
       echo "FAIL: $board $name exited $rc"
       failed=1
       continue
@@ -236,7 +345,7 @@ for b in "${boards[@]}"; do
       echo "FAIL: $board $name checksum $got, host-checksums.txt says $want"
       failed=1
     fi
-    read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+    read -r text data bss _ <"$out.size"
     parse_run "$out"
     check_ram "$board" "$name" || failed=1
     row="| $board | $name | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |"
@@ -254,21 +363,6 @@ done
 # 32x32 tiles into a windowed display (tiles): 12 per board.
 # "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
 # the default and no-depth runs above are two of them already.
-config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
-configs=(
-  "S8 u16 libm||depth-u16|default"
-  "S4 u16 libm|--features subpixel4|cubes-s4|"
-  "S8 u32 libm|--features depth-u32|cubes-u32|"
-  "S8 none libm|--features no-depth|no-depth|no-depth"
-  "S4 u32 libm|--features subpixel4,depth-u32|cubes-s4-u32|"
-  "S8 u16 micromath|--no-default-features --features micromath|cubes-micromath|"
-  "S4 u16 micromath|--no-default-features --features micromath,subpixel4|cubes-s4-micromath|"
-  "S8 u32 micromath|--no-default-features --features micromath,depth-u32|cubes-u32-micromath|"
-  "S4 u32 micromath|--no-default-features --features micromath,subpixel4,depth-u32|cubes-s4-u32-micromath|"
-  "S8 u16 libm no-i32-edges|--features no-i32-edges|depth-u16|"
-  "S8 u16 libm inv-w|--features inv-w|inv-w|"
-  "S8 u16 libm tiles 32x32|--features tiles|depth-u16|"
-)
 config_header="| board | configuration | frame | render | rasterization | RAM B |"
 config_rows=()
 # check_config BOARD LABEL "frame render raster": the 1 % check of
@@ -294,13 +388,9 @@ for b in "${config_boards[@]}"; do
       fi
     else
       out=$log/$board-config-${label// /-}.txt
-      set +e
-      # shellcheck disable=SC2086 # $args is a list of cargo arguments
-      timeout 900 cargo run -q --release --target "$target" $args </dev/null >"$out" 2>&1
-      rc=$?
-      set -e
+      rc=$(ran "$out")
       cat "$out"
-      if [ "$rc" -ne 0 ]; then
+      if [ "$rc" != 0 ]; then
         echo "FAIL: $board $label exited $rc"
         failed=1
         continue
@@ -329,13 +419,9 @@ spot_run() {
   local -n table=$5
   case $v in house*) step "$board ($target), the house: $v" ;; *) step "$board ($target), Spot: $v" ;; esac
   out=$log/$board-${v//,/+}.txt
-  set +e
-  timeout 900 cargo run -q --release --target "$target" --features "$v" </dev/null >"$out" 2>&1
-  rc=$?
-  set -e
+  rc=$(ran "$out")
   cat "$out"
-  elf=target/$target/release/microraster-firmware
-  if [ "$rc" -ne 0 ]; then
+  if [ "$rc" != 0 ]; then
     echo "FAIL: $board $v exited $rc"
     failed=1
     return 1
@@ -346,7 +432,7 @@ spot_run() {
     echo "FAIL: $board $v checksum $got, host-checksums.txt says ${want:-nothing} ($key)"
     failed=1
   fi
-  read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+  read -r text data bss _ <"$out.size"
   parse_run "$out"
   check_ram "$board" "$v" || failed=1
   table+=("| $board | $v | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
@@ -359,7 +445,7 @@ for b in "${boards[@]}"; do
   for v in "${spot_variants[@]}"; do
     case $board in microbit) key=$v-microbit ;; *) key=$v ;; esac
     spot_run "$target" "$board" "$v" "$key" spot_rows || continue
-    check_linked "$board" "$v" "$elf" || failed=1
+    check_linked "$board" "$v" "$out.fns" || failed=1
   done
 done
 
@@ -368,7 +454,6 @@ done
 # three cluster tests; each frame bit-identical to the host's unculled
 # one (build.rs) and to host-checksums.txt, counts of record in
 # docs/embedded.md.
-cluster_variants=(spot-flat,clusters spot-flat,cull-volumes spot-flat,cull-volumes-tree spot-flat,cull-cones spot-lit,clusters spot-lit,cull-volumes)
 # check_sweep BOARD NAME "CULLED EVERY": a camera sweep's mean render
 # instructions a frame, culled and with every cluster drawn, against the
 # sweep table of docs/embedded.md (as check_counts).
@@ -405,7 +490,6 @@ done
 # shading rows, each strip's own mask (its rows, the lecture's sectors)
 # or one mask a frame; each frame must be the unmasked one
 # (host-checksums.txt), counts of record in docs/embedded.md.
-mask_variants=(spot-flat,cull-masks spot-flat,cull-masks-frame spot-lit,cull-masks spot-lit,cull-masks-frame)
 mask_rows=()
 for v in "${mask_variants[@]}"; do
   spot_run thumbv7em-none-eabihf mps2-an386 "$v" "${v%%,*}" mask_rows || continue
@@ -420,7 +504,6 @@ done
 # `Occluder` (`herd-occlusion`); both frames must be the herd's host
 # frame (host-checksums.txt `spot-flat-herd`), counts of record in
 # docs/embedded.md, and the occlusion build must hide something.
-herd_variants=(spot-flat,herd spot-flat,herd-occlusion)
 herd_rows=()
 for v in "${herd_variants[@]}"; do
   spot_run thumbv7em-none-eabihf mps2-an386 "$v" spot-flat-herd herd_rows || continue
@@ -441,7 +524,6 @@ done
 # from the generator), counts of record in docs/embedded.md. The portal
 # build must skip something, and its sweep of 8 cameras compares each
 # culled frame with the whole one on the board (a difference fails it).
-house_variants=(house house-portals)
 house_rows=()
 house_sweep_rows=()
 for v in "${house_variants[@]}"; do
@@ -472,13 +554,9 @@ for b in "thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit"; do
   read -r target board <<<"$b"
   step "$board ($target), clipless"
   out=$log/$board-clipless.txt
-  set +e
-  timeout 900 cargo run -q --release --target "$target" --features clipless </dev/null >"$out" 2>&1
-  rc=$?
-  set -e
+  rc=$(ran "$out")
   cat "$out"
-  elf=target/$target/release/microraster-firmware
-  if [ "$rc" -ne 0 ]; then
+  if [ "$rc" != 0 ]; then
     echo "FAIL: $board clipless exited $rc"
     failed=1
     continue
@@ -489,7 +567,7 @@ for b in "thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit"; do
     echo "FAIL: $board clipless checksum $got, host-checksums.txt says ${want:-nothing}"
     failed=1
   fi
-  read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+  read -r text data bss _ <"$out.size"
   parse_run "$out"
   check_ram "$board" clipless || failed=1
   clipless_rows+=("| $board | clipless | $((text + data)) | $statics | $stack | $ram | $pixels | $frame | $display | $render | $clears | $geometry | $raster | $render_px |")
