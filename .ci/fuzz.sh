@@ -17,11 +17,13 @@
 # fuzz/artifacts/<target>/.
 #
 #   bash .ci/fuzz.sh                      # CI: a minute per target
-#                                         # (40 s libm build, 20 s micromath)
+#                                         # (40 s libm build, 20 s micromath),
+#                                         # one campaign a core at once
 #   FUZZ_SECONDS=1800 bash .ci/fuzz.sh    # 30 min per target, one after the
 #                                         # other (docs/accuracy.md has the
 #                                         # long run, both targets at once)
 #   FUZZ_JOBS=8 FUZZ_SECONDS=3600 bash .ci/fuzz.sh   # ... on 8 cores each
+#   FUZZ_PARALLEL=1 bash .ci/fuzz.sh      # one campaign at a time
 #   FUZZ_TARGETS=frame bash .ci/fuzz.sh   # one target
 #   FUZZ_BUILDS=libm bash .ci/fuzz.sh     # one build (libm or micromath)
 #
@@ -73,29 +75,37 @@ for b in $BUILDS; do
 done
 mkdir -p target/logs
 status=0
-# Findings first, one run per file (libFuzzer runs a file given as an
-# argument once; it would stop at the first that fails).
+# Findings first: every file through each target and build in one run
+# (libFuzzer runs each file given as an argument once, and stops at the
+# first that fails); where that run fails, one run per file names them.
+findings=()
+for f in findings/*; do
+  case "$f" in *.md) continue ;; esac
+  [ -f "$f" ] && findings+=("$f")
+done
+replay() { # TARGET BUILD LOG FILE...: runs the files once each
+  local t=$1 b=$2 log=$3
+  shift 3
+  # shellcheck disable=SC2046
+  cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "$@" -- \
+    -rss_limit_mb=4096 -timeout=30 >"$log" 2>&1
+}
 for t in $TARGETS; do
   for b in $BUILDS; do
-    n=0
-    for f in findings/*; do
-      case "$f" in *.md) continue ;; esac
-      [ -f "$f" ] || continue
-      n=$((n + 1))
-      log="target/logs/$t-$b-finding-$(basename "$f").log"
-      set +e
-      # shellcheck disable=SC2046
-      cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "$f" -- \
-        -rss_limit_mb=4096 -timeout=30 >"$log" 2>&1
-      rc=$?
-      set -e
-      if [ "$rc" -ne 0 ]; then
-        echo "!! $t ($b build): finding $f fails (exit $rc); from $log:"
-        grep -A2 -m1 'panicked at\|ERROR: ' "$log" || tail -n 20 "$log"
-        status=1
-      fi
-    done
-    echo "== $t ($b build): $n findings replayed"
+    [ "${#findings[@]}" -gt 0 ] || continue
+    replay "$t" "$b" "target/logs/$t-$b-findings.log" "${findings[@]}" && rc=0 || rc=$?
+    if [ "$rc" -ne 0 ]; then
+      for f in "${findings[@]}"; do
+        log="target/logs/$t-$b-finding-$(basename "$f").log"
+        replay "$t" "$b" "$log" "$f" && rc=0 || rc=$?
+        if [ "$rc" -ne 0 ]; then
+          echo "!! $t ($b build): finding $f fails (exit $rc); from $log:"
+          grep -A2 -m1 'panicked at\|ERROR: ' "$log" || tail -n 20 "$log"
+          status=1
+        fi
+      done
+    fi
+    echo "== $t ($b build): ${#findings[@]} findings replayed"
   done
 done
 for t in $TARGETS; do
@@ -106,27 +116,53 @@ for t in $TARGETS; do
   if [ -d "seeds/$seed" ]; then
     cp -n seeds/"$seed"/* "corpus/$t/" 2>/dev/null || true
   fi
+done
+# One campaign: TARGET BUILD SECONDS; prints its summary at its end (the
+# campaigns run FUZZ_PARALLEL at once) and leaves target/logs/T-B.status.
+campaign() {
+  local t=$1 b=$2 secs=$3 log="target/logs/$1-$2.log" rc report
+  # shellcheck disable=SC2046
+  cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "corpus/$t" --jobs "$JOBS" -- \
+    -max_total_time="$secs" -max_len="$MAX_LEN" -timeout=30 \
+    -rss_limit_mb=4096 -print_final_stats=1 >"$log" 2>&1 && rc=0 || rc=$?
+  report="== fuzz $t ($b build) for ${secs}s (jobs: $JOBS)"$'\n'
+  report+=$(grep -E 'stat::number_of_executed_units|stat::peak_rss_mb|^Done [0-9]+ runs' "$log" || true)$'\n'
+  report+=$(grep -E '^#[0-9]+' "$log" | tail -n 1 || true)$'\n'
+  if [ "$rc" -ne 0 ]; then
+    report+="!! $t ($b build) failed (exit $rc); the end of $log:"$'\n'
+    report+=$(tail -n 60 "$log"; ls -l "artifacts/$t" 2>/dev/null || true)
+  else
+    report+="ok: $t ($b build) ran clean ($(ls "corpus/$t" | wc -l) inputs in its corpus)"
+  fi
+  printf '%s\n' "$report"
+  echo "$rc" >"target/logs/$t-$b.status"
+}
+# Campaigns FUZZ_PARALLEL at once (default: the cores over FUZZ_JOBS),
+# each build's in turn: two campaigns of one target never run at once,
+# and the micromath build starts from what the libm build found.
+PARALLEL=${FUZZ_PARALLEL:-$(( $(nproc) / JOBS > 0 ? $(nproc) / JOBS : 1 ))}
+rm -f target/logs/*.status
+running=0
+for b in $BUILDS; do
+  secs=$SECONDS_PER_TARGET
+  [ "$b" = micromath ] && secs=$MICROMATH_SECONDS
+  for t in $TARGETS; do
+    if [ "$running" -ge "$PARALLEL" ]; then
+      wait -n || true
+      running=$((running - 1))
+    fi
+    campaign "$t" "$b" "$secs" &
+    running=$((running + 1))
+  done
+  wait
+  running=0
+done
+for t in $TARGETS; do
   for b in $BUILDS; do
-    secs=$SECONDS_PER_TARGET
-    [ "$b" = micromath ] && secs=$MICROMATH_SECONDS
-    echo "== fuzz $t ($b build) for ${secs}s (jobs: $JOBS)"
-    log="target/logs/$t-$b.log"
-    set +e
-    # shellcheck disable=SC2046
-    cargo +nightly fuzz run -O -a $(build_args "$b") "$t" "corpus/$t" --jobs "$JOBS" -- \
-      -max_total_time="$secs" -max_len="$MAX_LEN" -timeout=30 \
-      -rss_limit_mb=4096 -print_final_stats=1 >"$log" 2>&1
-    rc=$?
-    set -e
-    grep -E 'stat::number_of_executed_units|stat::peak_rss_mb|^Done [0-9]+ runs' "$log" || true
-    grep -E '^#[0-9]+' "$log" | tail -n 1 || true
-    if [ "$rc" -ne 0 ]; then
-      echo "!! $t ($b build) failed (exit $rc); the end of $log:"
-      tail -n 60 "$log"
-      ls -l "artifacts/$t" 2>/dev/null || true
+    rc=$(cat "target/logs/$t-$b.status" 2>/dev/null || echo missing)
+    if [ "$rc" != 0 ]; then
+      echo "!! $t ($b build): campaign exit $rc"
       status=1
-    else
-      echo "ok: $t ($b build) ran clean ($(ls "corpus/$t" | wc -l) inputs in its corpus)"
     fi
   done
 done
