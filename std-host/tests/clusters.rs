@@ -7,7 +7,7 @@
 use microraster::prelude::*;
 use microraster::{
     BoundingSphere, ClusterCull, ClusterTest, Config, Frame, Mat4, Mesh, MeshColors,
-    ProcessedVertex, SetupTriangle, Stats,
+    ProcessedVertex, SetupTriangle, Stats, MAX_PIECES,
 };
 mod common;
 
@@ -25,12 +25,17 @@ fn camera(m: &ClusteredMesh, dir: [f32; 3], dist: f32, jitter: [f32; 3]) -> Opti
 
 /// Colour and depth of the mesh drawn with `cull` (`None`: per triangle),
 /// with the mesh's bounding sphere where `bounded` (which the cluster
-/// tests then try first: `Eye::within`).
+/// tests then try first: `Eye::within`). The frame's storage holds seven
+/// pieces a triangle where `roomy` (then the submission stores at once),
+/// else one a triangle and 64 (it counts the pieces first, in one more
+/// walk of the tree). The vertex cache starts with the entries of another
+/// camera, which no triangle may read.
 fn draw<const S: u32>(
     m: &ClusteredMesh,
     mvp: &Mat4,
     cull: Option<ClusterCull>,
     bounded: bool,
+    roomy: bool,
 ) -> (Vec<u8>, Stats) {
     let colors: Vec<Rgb888> = (0..m.indices.len())
         .map(|i| Rgb888::new((i * 37) as u8, (i * 91) as u8, (i * 13) as u8))
@@ -43,9 +48,12 @@ fn draw<const S: u32>(
             .then(|| BoundingSphere::from_points(&m.positions))
             .flatten(),
     };
-    let mut storage = vec![SetupTriangle::EMPTY; m.indices.len() + 64];
+    let pieces = if roomy { MAX_PIECES } else { 1 };
+    let mut storage = vec![SetupTriangle::EMPTY; m.indices.len() * pieces + 64];
     let mut frame = Frame::<S>::with_subpixel_bits(Config::new(W, H), &mut storage).unwrap();
     let mut cache = vec![ProcessedVertex::default(); m.positions.len()];
+    let other = Mat4::perspective(1.0, 1.5, 0.1, 100.0);
+    frame.process_vertices(&other, &m.positions, &mut cache);
     match cull {
         None => frame.submit_mesh_cached(&mesh, mvp, 0, &mut cache).unwrap(),
         Some(c) => frame
@@ -96,17 +104,30 @@ fn differing(a: &[u8], b: &[u8]) -> usize {
 /// triangles the per-triangle path drops), so the frame is byte-identical,
 /// and every triangle is counted once.
 fn check<const S: u32>(m: &ClusteredMesh, mvp: &Mat4, bounded: bool) -> [(u64, usize); 4] {
-    let (want, base) = draw::<S>(m, mvp, None, bounded);
+    let (want, base) = draw::<S>(m, mvp, None, bounded, false);
     METHODS.map(|c| {
-        let (got, stats) = draw::<S>(m, mvp, Some(c), bounded);
-        let skipped = stats.culled_cluster + stats.culled_hierarchy;
-        assert_eq!(stats.submitted, base.submitted);
-        assert_eq!(stats.stored, base.stored, "{c:?} set up other pieces");
-        assert_eq!(stats.clipped, base.clipped);
-        assert_eq!(stats.dropped(), base.dropped());
-        let d = differing(&got, &want);
-        assert!(d == 0, "{c:?} changed the frame ({d} pixels)");
-        (skipped, d)
+        let mut result = (0, 0);
+        for roomy in [false, true] {
+            let (got, stats) = draw::<S>(m, mvp, Some(c), bounded, roomy);
+            let skipped = stats.culled_cluster + stats.culled_hierarchy;
+            assert_eq!(stats.submitted, base.submitted);
+            assert_eq!(
+                stats.stored, base.stored,
+                "{c:?} set up other pieces (roomy: {roomy})"
+            );
+            assert_eq!(stats.clipped, base.clipped);
+            assert_eq!(stats.dropped(), base.dropped());
+            let d = differing(&got, &want);
+            assert!(
+                d == 0,
+                "{c:?} changed the frame ({d} pixels, roomy: {roomy})"
+            );
+            if roomy {
+                assert_eq!(skipped, result.0, "{c:?} skipped other clusters with room");
+            }
+            result = (skipped, d);
+        }
+        result
     })
 }
 
