@@ -95,15 +95,20 @@ for t in $TARGETS; do
     [ "${#findings[@]}" -gt 0 ] || continue
     replay "$t" "$b" "target/logs/$t-$b-findings.log" "${findings[@]}" && rc=0 || rc=$?
     if [ "$rc" -ne 0 ]; then
+      status=1
+      named=0
       for f in "${findings[@]}"; do
         log="target/logs/$t-$b-finding-$(basename "$f").log"
         replay "$t" "$b" "$log" "$f" && rc=0 || rc=$?
         if [ "$rc" -ne 0 ]; then
           echo "!! $t ($b build): finding $f fails (exit $rc); from $log:"
           grep -A2 -m1 'panicked at\|ERROR: ' "$log" || tail -n 20 "$log"
-          status=1
+          named=1
         fi
       done
+      if [ "$named" = 0 ]; then
+        echo "!! $t ($b build): the findings fail run together, each passes alone; see target/logs/$t-$b-findings.log"
+      fi
     fi
     echo "== $t ($b build): ${#findings[@]} findings replayed"
   done
