@@ -290,10 +290,20 @@ echo 1 >"$log/queue.next"
 # The documented command (`cargo run --release --target T --features F`);
 # the runner in .cargo/config.toml starts QEMU under `timeout 300`, and
 # the outer timeout covers the build too.
+# The next job's line in the list (under a lock where there are workers
+# beside this one; util-linux's flock).
+take_job() {
+  local next='n=$(cat "$1"); echo $((n + 1)) >"$1"; echo "$n"'
+  if [ "$workers" -gt 1 ]; then
+    flock "$log/queue.lock" bash -c "$next" _ "$log/queue.next"
+  else
+    bash -c "$next" _ "$log/queue.next"
+  fi
+}
 fw_worker() { # WORKER: takes the next job of the list until none is left
   local dir=$root/examples/firmware/target/w$1 n line target out args fns rc elf
   while :; do
-    n=$(flock "$log/queue.lock" bash -c 'n=$(cat "$1"); echo $((n + 1)) >"$1"; echo "$n"' _ "$log/queue.next")
+    n=$(take_job)
     line=$(sed -n "${n}p" "$jobs_list")
     [ -n "$line" ] || return 0
     IFS='|' read -r target out args fns <<<"$line"
@@ -311,6 +321,7 @@ fw_worker() { # WORKER: takes the next job of the list until none is left
 }
 workers=${FIRMWARE_JOBS:-$(nproc)}
 [ "$workers" -le 4 ] || workers=4
+command -v flock >/dev/null || workers=1
 step "building and running $(wc -l <"$jobs_list") firmware builds, $workers at once"
 pids=()
 for ((w = 0; w < workers; w++)); do
