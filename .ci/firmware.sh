@@ -227,6 +227,13 @@ check_linked() {
   fi
 }
 
+# The configuration sweep (cubes, set up once), on the M4F and the M0:
+# the report's eight configurations (subpixel bits 8 / 4, depth u16 / u32,
+# float backend libm / micromath), and from the default S8 u16 libm no
+# depth buffer and the i32 edge fast path off, 1/w depth (inv-w) and
+# 32x32 tiles into a windowed display (tiles): 12 per board.
+# "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
+# the default and no-depth runs of the cubes are two of them already.
 config_boards=("thumbv7em-none-eabihf mps2-an386" "thumbv6m-none-eabi microbit")
 configs=(
   "S8 u16 libm||depth-u16|default"
@@ -287,9 +294,6 @@ for v in "${cluster_variants[@]}" "${mask_variants[@]}" "${herd_variants[@]}" "$
 done
 rm -f "$log/queue.next" "$log"/*.rc "$log"/*.size "$log"/*.fns
 echo 1 >"$log/queue.next"
-# The documented command (`cargo run --release --target T --features F`);
-# the runner in .cargo/config.toml starts QEMU under `timeout 300`, and
-# the outer timeout covers the build too.
 # The next job's line in the list (under a lock where there are workers
 # beside this one; util-linux's flock).
 take_job() {
@@ -300,7 +304,11 @@ take_job() {
     bash -c "$next" _ "$log/queue.next"
   fi
 }
-fw_worker() { # WORKER: takes the next job of the list until none is left
+# WORKER: takes the next job of the list until none is left. Each job is
+# the documented command (`cargo run --release --target T --features F`);
+# the runner in .cargo/config.toml starts QEMU under `timeout 300`, and
+# the outer timeout covers the build too.
+fw_worker() {
   local dir=$root/examples/firmware/target/w$1 n line target out args fns rc elf
   while :; do
     n=$(take_job)
@@ -367,13 +375,6 @@ for b in "${boards[@]}"; do
   done
 done
 
-# The configuration sweep (cubes, set up once), on the M4F and the M0:
-# the report's eight configurations (subpixel bits 8 / 4, depth u16 / u32,
-# float backend libm / micromath), and from the default S8 u16 libm no
-# depth buffer and the i32 edge fast path off, 1/w depth (inv-w) and
-# 32x32 tiles into a windowed display (tiles): 12 per board.
-# "label|cargo arguments|key in host-checksums.txt|variant run to reuse":
-# the default and no-depth runs above are two of them already.
 config_header="| board | configuration | frame | render | rasterization | RAM B |"
 config_rows=()
 # check_config BOARD LABEL "frame render raster": the 1 % check of

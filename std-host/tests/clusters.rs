@@ -27,9 +27,10 @@ fn camera(m: &ClusteredMesh, dir: [f32; 3], dist: f32, jitter: [f32; 3]) -> Opti
 /// with the mesh's bounding sphere where `bounded` (which the cluster
 /// tests then try first: `Eye::within`). The frame's storage holds seven
 /// pieces a triangle where `roomy` (then the submission stores at once),
-/// else one a triangle and 64 (it counts the pieces first, in one more
-/// walk of the tree). The vertex cache starts with the entries of another
-/// camera, which no triangle may read.
+/// else one a triangle and 64 (it bounds its pieces first: a pass over
+/// the cache, and a walk of the tree where a vertex needs clipping). The
+/// vertex cache starts with the entries of another camera, which no
+/// triangle may read.
 fn draw<const S: u32>(
     m: &ClusteredMesh,
     mvp: &Mat4,
