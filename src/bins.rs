@@ -116,31 +116,107 @@ fn tile_count(config: &Config, tw: u32, th: u32) -> Option<usize> {
     (c as usize).checked_mul(r as usize)
 }
 
-/// The tile rows and tile columns (of `tw x th` tiles) triangle `t`'s box
+/// Division of a pixel coordinate (`0..=u16::MAX`, as a triangle's box
+/// holds it) by a tile side `d >= 1` fixed for a whole binning pass.
+///
+/// Binning divides each stored triangle's four box sides by the tile
+/// size in each of its passes (count, fill, and [`entries`]): a hardware
+/// `div` of 12 to 26 cycles on x86-64, most of the bunny's binning time.
+/// On 64-bit targets the quotient is a multiply and a shift instead, exact
+/// for every such `x` and `d`:
+///
+/// with `m = floor(2^32 / d) + 1`, `m d = 2^32 + e` for some `0 < e <= d`.
+/// For `x = q d + r`, `0 <= r < d`:
+/// `x m / 2^32 = q + r / d + x e / (d 2^32)`, which is at least `q` and
+/// below `q + (d - 1) / d + x / 2^32 < q + (d - 1) / d + 1 / d = q + 1`
+/// wherever `x d < 2^32`, true for `x, d < 2^16`. A divisor of `2^16` or
+/// more has quotient 0 for every such `x`, as `m = 0` gives. `x m` fits
+/// `u64` (`m <= 2^32 + 1`).
+///
+/// 32-bit targets keep the division: their `u64` product is a library
+/// call on the Cortex-M0, and the M3 and M4F divide in a few cycles.
+/// `tests::div16_equals_division` checks the quotients.
+#[derive(Clone, Copy, Debug)]
+struct Div16 {
+    #[cfg(not(target_pointer_width = "64"))]
+    d: u32,
+    #[cfg(target_pointer_width = "64")]
+    m: u64,
+}
+
+impl Div16 {
+    /// Division by `d` (0 counts as 1).
+    fn new(d: u32) -> Self {
+        let d = d.max(1);
+        #[cfg(target_pointer_width = "64")]
+        {
+            let m = if d > u16::MAX as u32 {
+                0
+            } else {
+                (1u64 << 32) / d as u64 + 1
+            };
+            Div16 { m }
+        }
+        #[cfg(not(target_pointer_width = "64"))]
+        {
+            Div16 { d }
+        }
+    }
+
+    /// `floor(x / d)`.
+    #[inline(always)]
+    fn of(self, x: u16) -> u32 {
+        #[cfg(target_pointer_width = "64")]
+        {
+            ((x as u64 * self.m) >> 32) as u32
+        }
+        #[cfg(not(target_pointer_width = "64"))]
+        {
+            x as u32 / self.d
+        }
+    }
+}
+
+/// A binning pass's tile sides, as divisions.
+#[derive(Clone, Copy, Debug)]
+struct TileSize {
+    w: Div16,
+    h: Div16,
+}
+
+impl TileSize {
+    /// Tiles of `tw x th` (0 counts as 1).
+    fn new(tw: u32, th: u32) -> Self {
+        TileSize {
+            w: Div16::new(tw),
+            h: Div16::new(th),
+        }
+    }
+}
+
+/// The tile rows and tile columns (of `size` tiles) triangle `t`'s box
 /// touches.
 #[inline]
 fn tile_range<const N: usize>(
     t: &SetupTriangle<N>,
-    tw: u32,
-    th: u32,
+    size: TileSize,
 ) -> (
     core::ops::RangeInclusive<u32>,
     core::ops::RangeInclusive<u32>,
 ) {
     (
-        t.min_y as u32 / th..=t.max_y as u32 / th,
-        t.min_x as u32 / tw..=t.max_x as u32 / tw,
+        size.h.of(t.min_y)..=size.h.of(t.max_y),
+        size.w.of(t.min_x)..=size.w.of(t.max_x),
     )
 }
 
 /// The indices of the tiles (`cols` a row) triangle `t`'s box touches.
 fn tiles_of<const N: usize>(
     t: &SetupTriangle<N>,
-    tw: u32,
-    th: u32,
+    size: TileSize,
     cols: u32,
 ) -> impl Iterator<Item = usize> {
-    let (rows, columns) = tile_range(t, tw, th);
+    let (rows, columns) = tile_range(t, size);
     rows.flat_map(move |r| {
         columns
             .clone()
@@ -152,9 +228,9 @@ fn tiles_of<const N: usize>(
 /// tile its box touches); saturates at `usize::MAX` (then no storage can
 /// hold them).
 pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], tw: u32, th: u32) -> usize {
-    let (tw, th) = (tw.max(1), th.max(1));
+    let size = TileSize::new(tw, th);
     triangles.iter().fold(0usize, |n, t| {
-        let (rows, cols) = tile_range(t, tw, th);
+        let (rows, cols) = tile_range(t, size);
         let k = (rows.end() - rows.start()) as usize + 1;
         n.saturating_add(k.saturating_mul((cols.end() - cols.start()) as usize + 1))
     })
@@ -162,13 +238,15 @@ pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], tw: u32, t
 
 /// Sorts `triangles` of a frame of `config` into bins of `tile_w x
 /// tile_h` tiles; see [`Frame::bin_tiles`](crate::Frame::bin_tiles). A
-/// tile at least as wide as the frame is a strip.
+/// tile at least as wide as the frame is a strip. `items` is called once,
+/// with the entries needed, after the tile size and `offsets` passed their
+/// checks, and returns the item storage.
 pub(crate) fn bin<'b, const N: usize>(
     config: &Config,
     triangles: &[SetupTriangle<N>],
     (tile_w, tile_h): (u32, u32),
     offsets: &'b mut [u32],
-    items: &'b mut [u32],
+    items: impl FnOnce(usize) -> &'b mut [u32],
 ) -> Result<Bins<'b>, Error> {
     if tile_h == 0 {
         return Err(Error::InvalidStripRows);
@@ -178,7 +256,6 @@ pub(crate) fn bin<'b, const N: usize>(
     }
     let (tw, th) = (tile_w.min(config.width.max(1)), tile_h);
     let cols = grid(config, tw, th).0;
-    let need_items = entries(triangles, tw, th);
     // At most MAX_DIMENSION^2 tiles: this never overflows a 32-bit usize.
     let tiles = tile_count(config, tw, th).unwrap_or(usize::MAX);
     if offsets.len() < tiles.saturating_add(1) {
@@ -187,6 +264,8 @@ pub(crate) fn bin<'b, const N: usize>(
             actual: offsets.len(),
         });
     }
+    let need_items = entries(triangles, tw, th);
+    let items = items(need_items);
     if items.len() < need_items || need_items > u32::MAX as usize {
         return Err(Error::BinStorageSize {
             expected: need_items,
@@ -195,12 +274,13 @@ pub(crate) fn bin<'b, const N: usize>(
     }
     let offsets = &mut offsets[..tiles + 1];
     offsets.fill(0);
+    let size = TileSize::new(tw, th);
     // Count into offsets[s + 1], prefix-sum into starts, fill using
     // offsets[s] as the cursor (it ends at the start of s + 1), then shift
     // back: no scratch beyond the two slices. Every sum is at most
     // `need_items <= u32::MAX`.
     for t in triangles {
-        for s in tiles_of(t, tw, th, cols) {
+        for s in tiles_of(t, size, cols) {
             if let Some(o) = offsets.get_mut(s + 1) {
                 *o += 1;
             }
@@ -210,7 +290,7 @@ pub(crate) fn bin<'b, const N: usize>(
         offsets[s] += offsets[s - 1];
     }
     for (i, t) in triangles.iter().enumerate() {
-        for s in tiles_of(t, tw, th, cols) {
+        for s in tiles_of(t, size, cols) {
             if let Some(o) = offsets.get_mut(s) {
                 if let Some(slot) = items.get_mut(*o as usize) {
                     *slot = i as u32;
@@ -233,4 +313,41 @@ pub(crate) fn bin<'b, const N: usize>(
         offsets,
         items: &items[..need_items],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Every divisor a tile side can take below `2^16` and beyond, with
+    /// the numerators where a quotient steps (`k d - 1`, `k d`) and the
+    /// largest coordinate.
+    #[test]
+    fn div16_equals_division_where_quotients_step() {
+        let max = u16::MAX as u32;
+        // Under Miri (slow), every 61st divisor below 2^16.
+        let stride = if cfg!(miri) { 61 } else { 1 };
+        let ds = (1..=max)
+            .step_by(stride)
+            .chain([max, 1 << 16, (1 << 16) + 1, 1 << 20, u32::MAX]);
+        for d in ds {
+            let div = Div16::new(d);
+            let ends = [0, 1, max - 1, max, d - 1, d, d.saturating_add(1)];
+            let steps = (1..=max / d.min(max))
+                .step_by(97)
+                .flat_map(|k| [k * d - 1, k * d]);
+            for x in ends.into_iter().chain(steps).filter(|&x| x <= max) {
+                assert_eq!(div.of(x as u16), x / d, "{x} / {d}");
+            }
+        }
+        assert_eq!(Div16::new(0).of(12345), 12345, "0 counts as 1");
+    }
+
+    proptest! {
+        #[test]
+        fn div16_equals_division(x in any::<u16>(), d in 1u32..=70_000) {
+            prop_assert_eq!(Div16::new(d).of(x), x as u32 / d);
+        }
+    }
 }

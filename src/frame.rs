@@ -310,6 +310,29 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             self.triangles(),
             (tile_w, tile_h),
             offsets,
+            |_| items,
+        )
+    }
+
+    /// [`Frame::bin_tiles`] with the item storage given once the number of
+    /// entries is known: `items(need)` is called once, with
+    /// [`Frame::tile_bin_entries`]` (tile_w, tile_h)`, where the tile size
+    /// and `offsets` are right, and returns the storage (shorter than
+    /// `need` is the same error). A host that grows a `Vec` to `need` here
+    /// walks the triangles once less than one that asks
+    /// `tile_bin_entries` first.
+    pub fn bin_tiles_with<'b>(
+        &self,
+        tile_w: u32,
+        tile_h: u32,
+        offsets: &'b mut [u32],
+        items: impl FnOnce(usize) -> &'b mut [u32],
+    ) -> Result<Bins<'b>, Error> {
+        bins::bin(
+            &self.stage.config,
+            self.triangles(),
+            (tile_w, tile_h),
+            offsets,
             items,
         )
     }
@@ -332,7 +355,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             self.triangles(),
             (self.stage.config.width, strip_rows),
             offsets,
-            items,
+            |_| items,
         )
     }
 

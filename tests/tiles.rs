@@ -198,9 +198,28 @@ fn check_tiles<const S: u32, const N: usize>(
     let whole = render(&frame, [0, w, 0, h], None);
 
     let mut offsets = vec![0u32; frame.tiles(tw, th) + 1];
-    let mut items = vec![0u32; frame.tile_bin_entries(tw, th)];
+    let need = frame.tile_bin_entries(tw, th);
+    let mut items = vec![0u32; need];
     let bins = frame.bin_tiles(tw, th, &mut offsets, &mut items).unwrap();
     prop_assert_eq!(bins.tiles() as usize, frame.tiles(tw, th));
+    // The same bins with the items given once their number is known: the
+    // storage is asked for once, for exactly what `tile_bin_entries` says.
+    {
+        let mut offsets2 = vec![0u32; frame.tiles(tw, th) + 1];
+        let (mut items2, mut asked) = (Vec::new(), Vec::new());
+        let bins2 = frame
+            .bin_tiles_with(tw, th, &mut offsets2, |need| {
+                asked.push(need);
+                items2.resize(need, u32::MAX);
+                &mut items2[..]
+            })
+            .unwrap();
+        prop_assert_eq!(bins2.tiles(), bins.tiles());
+        for t in 0..bins.tiles() {
+            prop_assert_eq!(bins2.strip_items(t), bins.strip_items(t));
+        }
+        prop_assert_eq!(asked, vec![need]);
+    }
     let mut tiled = Images::blank((w * h) as usize);
     for t in 0..bins.tiles() {
         let r = bins.rect(t);
@@ -416,6 +435,44 @@ fn bad_rectangles_and_tile_sizes_are_typed_errors() {
         frame.bin_tiles(7, 6, &mut o, &mut i[..need - 1]),
         Err(Error::BinStorageSize { .. })
     ));
+    // `bin_tiles_with` checks the tile size and the offsets before it asks
+    // for items, and takes short items as the same error.
+    let mut asked = 0;
+    assert_eq!(
+        frame
+            .bin_tiles_with(0, 6, &mut o, |_| {
+                asked += 1;
+                &mut []
+            })
+            .unwrap_err(),
+        Error::InvalidTileSize
+    );
+    assert_eq!(
+        frame
+            .bin_tiles_with(7, 6, &mut o[..15], |_| {
+                asked += 1;
+                &mut []
+            })
+            .unwrap_err(),
+        Error::BinStorageSize {
+            expected: 16,
+            actual: 15
+        }
+    );
+    assert_eq!(asked, 0, "items asked for before the checks");
+    let mut short = vec![0u32; need - 1];
+    assert_eq!(
+        frame
+            .bin_tiles_with(7, 6, &mut o, |n| {
+                assert_eq!(n, need);
+                &mut short[..]
+            })
+            .unwrap_err(),
+        Error::BinStorageSize {
+            expected: need,
+            actual: need - 1
+        }
+    );
     let bins = frame.bin_tiles(7, 6, &mut o, &mut i).unwrap();
     assert_eq!(
         bins.rect(4),

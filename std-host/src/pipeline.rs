@@ -595,6 +595,29 @@ fn build_chunks<'s, const S: u32>(
     })
 }
 
+/// Bins `f` into tiles of `tile_w x tile_h` in `bins` (offsets, items),
+/// each grown to what the frame needs as it is binned (the items to the
+/// bins' own count of entries: no pass over the triangles beforehand).
+fn bin_growing<'b, const S: u32>(
+    f: &Frame<'_, S>,
+    tile_w: u32,
+    tile_h: u32,
+    (offsets, items): &'b mut (Vec<u32>, Vec<u32>),
+) -> Result<Bins<'b>, String> {
+    let tiles = f.tiles(tile_w, tile_h);
+    if offsets.len() < tiles + 1 {
+        offsets.resize(tiles + 1, 0);
+    }
+    f.bin_tiles_with(tile_w, tile_h, offsets, |need| {
+        // Over `u32::MAX` entries is an error, not an allocation.
+        if items.len() < need && need <= u32::MAX as usize {
+            items.resize(need, 0);
+        }
+        items
+    })
+    .map_err(|e| e.to_string())
+}
+
 /// Whether detail culling (`config.detail`) drops object `o` whole, by its
 /// bounds: then no vertex of it is processed, and `submit_mesh` drops it
 /// (drawing its box where it has a fill).
@@ -764,40 +787,26 @@ impl<const S: u32> FramePipeline<S> {
         // Binning.
         let t2 = Instant::now();
         bins.resize_with(frames.len(), Default::default);
-        for (f, (offsets, items)) in frames.iter().zip(bins.iter_mut()) {
-            let tiles = f.tiles(tile_w, strip_rows);
-            if offsets.len() < tiles + 1 {
-                offsets.resize(tiles + 1, 0);
-            }
-            let need = f.tile_bin_entries(tile_w, strip_rows);
-            if items.len() < need {
-                items.resize(need, 0);
-            }
-        }
+        let bin = |f, b| bin_growing::<S>(f, tile_w, strip_rows, b);
         // One frame per setup worker: bin them in parallel too.
         let binned = if frames.len() > 1 {
             std::thread::scope(|s| {
                 let handles: Vec<_> = frames
                     .iter()
                     .zip(bins.iter_mut())
-                    .map(|(f, (o, i))| s.spawn(move || f.bin_tiles(tile_w, strip_rows, o, i)))
+                    .map(|(f, b)| s.spawn(move || bin(f, b)))
                     .collect();
                 handles
                     .into_iter()
-                    .map(|h| {
-                        h.join()
-                            .map_err(|_| "binning worker failed".to_string())?
-                            .map_err(|e| e.to_string())
-                    })
+                    .map(|h| h.join().map_err(|_| "binning worker failed".to_string())?)
                     .collect::<Result<Vec<_>, String>>()
             })?
         } else {
             frames
                 .iter()
                 .zip(bins.iter_mut())
-                .map(|(f, (o, i))| f.bin_tiles(tile_w, strip_rows, o, i))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| e.to_string())?
+                .map(|(f, b)| bin(f, b))
+                .collect::<Result<Vec<_>, _>>()?
         };
         let layers: Vec<Layer<'_, '_, S>> = frames.iter().zip(binned.iter()).collect();
         let binning_ms = ms(t2);
