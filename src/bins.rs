@@ -241,12 +241,18 @@ pub(crate) fn entries<const N: usize>(triangles: &[SetupTriangle<N>], tw: u32, t
 /// tile at least as wide as the frame is a strip. `items` is called once,
 /// with the entries needed, after the tile size and `offsets` passed their
 /// checks, and returns the item storage.
+///
+/// `count_first`: the entries are found by counting them into `offsets`
+/// (one pass over the triangles fewer), so `offsets` holds those counts
+/// where the items then turn out too short; otherwise they are found by a
+/// pass of their own, and an error leaves both slices as they were.
 pub(crate) fn bin<'b, const N: usize>(
     config: &Config,
     triangles: &[SetupTriangle<N>],
     (tile_w, tile_h): (u32, u32),
     offsets: &'b mut [u32],
     items: impl FnOnce(usize) -> &'b mut [u32],
+    count_first: bool,
 ) -> Result<Bins<'b>, Error> {
     if tile_h == 0 {
         return Err(Error::InvalidStripRows);
@@ -264,7 +270,28 @@ pub(crate) fn bin<'b, const N: usize>(
             actual: offsets.len(),
         });
     }
-    let need_items = entries(triangles, tw, th);
+    let offsets = &mut offsets[..tiles + 1];
+    let size = TileSize::new(tw, th);
+    // Counts into offsets[s + 1]; returns their sum, saturating (a tile's
+    // count wraps only where the sum exceeds `u32::MAX`, an error below).
+    let count = |offsets: &mut [u32]| {
+        offsets.fill(0);
+        let mut n = 0usize;
+        for t in triangles {
+            for s in tiles_of(t, size, cols) {
+                if let Some(o) = offsets.get_mut(s + 1) {
+                    *o = o.wrapping_add(1);
+                }
+                n = n.saturating_add(1);
+            }
+        }
+        n
+    };
+    let need_items = if count_first {
+        count(offsets)
+    } else {
+        entries(triangles, tw, th)
+    };
     let items = items(need_items);
     if items.len() < need_items || need_items > u32::MAX as usize {
         return Err(Error::BinStorageSize {
@@ -272,20 +299,12 @@ pub(crate) fn bin<'b, const N: usize>(
             actual: items.len(),
         });
     }
-    let offsets = &mut offsets[..tiles + 1];
-    offsets.fill(0);
-    let size = TileSize::new(tw, th);
-    // Count into offsets[s + 1], prefix-sum into starts, fill using
-    // offsets[s] as the cursor (it ends at the start of s + 1), then shift
-    // back: no scratch beyond the two slices. Every sum is at most
-    // `need_items <= u32::MAX`.
-    for t in triangles {
-        for s in tiles_of(t, size, cols) {
-            if let Some(o) = offsets.get_mut(s + 1) {
-                *o += 1;
-            }
-        }
+    if !count_first {
+        count(offsets);
     }
+    // Prefix-sum the counts into starts, fill using offsets[s] as the
+    // cursor (it ends at the start of s + 1), then shift back: no scratch
+    // beyond the two slices. Every sum is at most `need_items <= u32::MAX`.
     for s in 1..offsets.len() {
         offsets[s] += offsets[s - 1];
     }

@@ -311,6 +311,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             (tile_w, tile_h),
             offsets,
             |_| items,
+            false,
         )
     }
 
@@ -318,9 +319,11 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
     /// entries is known: `items(need)` is called once, with
     /// [`Frame::tile_bin_entries`]` (tile_w, tile_h)`, where the tile size
     /// and `offsets` are right, and returns the storage (shorter than
-    /// `need` is the same error). A host that grows a `Vec` to `need` here
-    /// walks the triangles once less than one that asks
-    /// `tile_bin_entries` first.
+    /// `need` is the same error). The entries are counted into `offsets`
+    /// on the way (`bin_tiles` counts them apart first), so it walks the
+    /// triangles twice where `tile_bin_entries` and `bin_tiles` walk them
+    /// four times, and where the items are too short `offsets` is left
+    /// holding the counts (`bin_tiles` writes nothing on any error).
     pub fn bin_tiles_with<'b>(
         &self,
         tile_w: u32,
@@ -334,6 +337,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             (tile_w, tile_h),
             offsets,
             items,
+            true,
         )
     }
 
@@ -356,6 +360,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
             (self.stage.config.width, strip_rows),
             offsets,
             |_| items,
+            false,
         )
     }
 

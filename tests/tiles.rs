@@ -473,6 +473,9 @@ fn bad_rectangles_and_tile_sizes_are_typed_errors() {
             actual: need - 1
         }
     );
+    // It counted the entries into the offsets on the way.
+    assert_eq!(o[0], 0);
+    assert_eq!(o[1..16].iter().sum::<u32>() as usize, need);
     let bins = frame.bin_tiles(7, 6, &mut o, &mut i).unwrap();
     assert_eq!(
         bins.rect(4),
