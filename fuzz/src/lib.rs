@@ -1343,6 +1343,36 @@ fn check_frame_typed<const S: u32, C: PixelWord, T: DepthGuard>(
         );
     }
     assert_eq!(total, entries);
+    // The same bins with the items asked for once counted (a strip is a
+    // tile as wide as the frame); one short is the same error.
+    {
+        let mut offsets = vec![SENT; strips + 1];
+        let mut short = vec![SENT; entries.saturating_sub(1)];
+        if entries > 0 {
+            let e = frame
+                .bin_tiles_with(w as u32, r, &mut offsets, |n| {
+                    assert_eq!(n, entries, "asked for the wrong count");
+                    &mut short[..]
+                })
+                .map(|_| ());
+            assert!(matches!(e, Err(Error::BinStorageSize { .. })), "{e:?}");
+            assert!(short.iter().all(|&v| v == SENT), "an error wrote items");
+        }
+        let mut items = Vec::new();
+        let counted = frame
+            .bin_tiles_with(w as u32, r, &mut offsets, |n| {
+                items.resize(n, SENT);
+                &mut items[..]
+            })
+            .expect("bin_tiles_with");
+        assert_eq!(counted.strips(), bins.strips());
+        for s in 0..bins.strips() {
+            assert!(
+                counted.strip_items(s) == bins.strip_items(s),
+                "bin_tiles_with: bin {s} differs"
+            );
+        }
+    }
     for s in [
         bins.strips(),
         bins.strips().saturating_add(input.past),
