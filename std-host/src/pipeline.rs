@@ -4,10 +4,13 @@
 //! Design note: [`FramePipeline::with_layers`] runs three stages. The vertex
 //! stage processes every object inside the frustum once, in parallel chunks
 //! of at least [`VERTEX_CHUNK_MIN`] vertices. The triangle stage splits the
-//! scene's triangle sequence into up to `threads` contiguous [`Piece`]s
-//! ([`partition`]; one chunk below [`PARALLEL_SETUP_MIN_TRIANGLES`]) and
-//! [`fill`]s each chunk into its own [`Frame`] and setup storage. Binning then
-//! sorts each frame's triangles by strip. Every frame is set up exactly once:
+//! scene's triangle sequence into up to `threads` contiguous [`Piece`]s of
+//! about equal estimated work ([`partition_by`] with a sample of which
+//! triangles culling keeps; one chunk below [`PARALLEL_SETUP_MIN_TRIANGLES`])
+//! and [`fill`]s each chunk into its own [`Frame`] and setup storage. Binning
+//! then sorts each frame's triangles by strip, into bins grown to what it
+//! counts ([`Frame::bin_tiles_with`]). Each parallel stage runs one worker on
+//! the calling thread. Every frame is set up exactly once:
 //! storage is sized from the triangle count, and only when a chunk reports
 //! [`Error::StorageFull`] (clipping made more triangles than the guess) are
 //! the full storages grown and the chunks built again. The pipeline keeps its
