@@ -305,14 +305,7 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         offsets: &'b mut [u32],
         items: &'b mut [u32],
     ) -> Result<Bins<'b>, Error> {
-        bins::bin(
-            &self.stage.config,
-            self.triangles(),
-            (tile_w, tile_h),
-            offsets,
-            |_| items,
-            false,
-        )
+        self.bin_in((tile_w, tile_h), offsets, |_| items, false)
     }
 
     /// [`Frame::bin_tiles`] with the item storage given once the number of
@@ -331,14 +324,19 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         offsets: &'b mut [u32],
         items: impl FnOnce(usize) -> &'b mut [u32],
     ) -> Result<Bins<'b>, Error> {
-        bins::bin(
-            &self.stage.config,
-            self.triangles(),
-            (tile_w, tile_h),
-            offsets,
-            items,
-            true,
-        )
+        self.bin_in((tile_w, tile_h), offsets, items, true)
+    }
+
+    /// [`bins::bin`] of the stored triangles.
+    fn bin_in<'b>(
+        &self,
+        tile: (u32, u32),
+        offsets: &'b mut [u32],
+        items: impl FnOnce(usize) -> &'b mut [u32],
+        count_first: bool,
+    ) -> Result<Bins<'b>, Error> {
+        let (config, triangles) = (&self.stage.config, self.triangles());
+        bins::bin(config, triangles, tile, offsets, items, count_first)
     }
 
     /// Sorts the stored triangles into per-strip bins (strips of
@@ -354,14 +352,8 @@ impl<'s, const S: u32, const N: usize> Frame<'s, S, N> {
         offsets: &'b mut [u32],
         items: &'b mut [u32],
     ) -> Result<Bins<'b>, Error> {
-        bins::bin(
-            &self.stage.config,
-            self.triangles(),
-            (self.stage.config.width, strip_rows),
-            offsets,
-            |_| items,
-            false,
-        )
+        let strip = (self.stage.config.width, strip_rows);
+        self.bin_in(strip, offsets, |_| items, false)
     }
 
     /// [`Frame::render_strip`] with the fragment shader `fragment` (see
