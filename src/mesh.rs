@@ -263,6 +263,11 @@ impl ProcessedVertex {
         snapped: false,
     };
 
+    /// Its clip-space position, as the vertex stage computed it.
+    pub fn clip_position(&self) -> Vec4 {
+        self.pos
+    }
+
     /// Not processed this frame: counted as non-finite if a triangle uses
     /// it (a cluster set whose vertex list misses one of its triangles'
     /// vertices).

@@ -161,22 +161,26 @@ const WORK_SAMPLE: usize = 64;
 const KEPT_WORK: u64 = 3;
 
 /// Object `o`'s triangles as runs of [`WORK_SAMPLE`] with their estimated
-/// setup work ([`partition_by`]): each run's first triangle, transformed
-/// here, stands for the run, kept (work [`KEPT_WORK`]) unless it is
-/// culled as a back (front) face or lies outside one side of the view.
-/// Only the split among the setup workers depends on it, not the image.
-fn setup_work(o: &crate::scene::Object, config: &Config, visible: bool) -> Vec<(usize, u64)> {
-    let n = o.indices.len();
-    let whole = o.clusters.is_some() || o.normal_classes.is_some();
-    if !visible || whole || config.cull == CullMode::None {
-        return vec![(n, 1)];
-    }
+/// setup work ([`partition_by`]): each run's first triangle, read from the
+/// vertex stage's `cache` (`None`: the object is outside the frustum),
+/// stands for the run, kept (work [`KEPT_WORK`]) unless it is culled as a
+/// back (front) face or lies outside one side of the view. Only the split
+/// among the setup workers depends on it, not the image.
+fn setup_work(
+    o: &crate::scene::Object,
+    config: &Config,
+    cache: Option<&[ProcessedVertex]>,
+) -> Vec<(usize, u64)> {
+    // (Clustered and masked objects have no cache: they are submitted whole.)
+    let Some(cache) = cache.filter(|_| config.cull != CullMode::None) else {
+        return vec![(o.indices.len(), 1)];
+    };
     let ccw_front = config.front_face == FrontFace::Ccw;
     let kept = |t: &[u32; 3]| {
         let mut p = [Vec4::new(0.0, 0.0, 0.0, 0.0); 3];
         for (p, &i) in p.iter_mut().zip(t) {
-            match o.positions.get(i as usize) {
-                Some(&v) => *p = o.mvp.transform_point(v),
+            match cache.get(i as usize) {
+                Some(v) => *p = v.clip_position(),
                 None => return false,
             }
         }
@@ -871,7 +875,7 @@ impl<const S: u32> FramePipeline<S> {
         // equal halves).
         let chunks = if parts > 1 {
             partition_by(scene, parts, |i| {
-                setup_work(&scene.objects[i], &config, caches[i].is_some())
+                setup_work(&scene.objects[i], &config, caches[i])
             })
         } else {
             partition(scene, 1)
@@ -1040,6 +1044,43 @@ mod tests {
                 assert_eq!(r.start, next[k]);
                 next[k] = r.end;
             }
+        }
+    }
+
+    /// Each run's estimate (kept or not) agrees with what the core keeps
+    /// of the triangle that stands for it, for every triangle of the cubes
+    /// taken in turn as the sample, with back and front faces culled; no
+    /// culling counts every triangle as work 1.
+    #[test]
+    fn setup_work_says_what_the_core_keeps() {
+        let scene = cubes_scene(&View::new(64, 48)).unwrap();
+        for cull in [CullMode::Back, CullMode::Front, CullMode::None] {
+            let mut config = Config::new(64, 48);
+            config.cull = cull;
+            let mut caches = Vec::new();
+            let caches = vertex_stage::<8>(config, 1, &scene, &mut caches).unwrap();
+            let mut kept_some = [false; 2];
+            for (i, o) in scene.objects.iter().enumerate() {
+                let n = o.indices.len();
+                for k in 0..n {
+                    let mut storage = vec![SetupTriangle::EMPTY; 16];
+                    let mut f = Frame::<8>::new(config, &mut storage).unwrap();
+                    fill(&mut f, &scene, &[Piece::Object(i, k..k + 1)], &caches).unwrap();
+                    let core = !f.triangles().is_empty();
+                    kept_some[core as usize] = true;
+                    // The object with triangle k first.
+                    let mut rotated = o.clone();
+                    rotated.indices.rotate_left(k);
+                    let work = setup_work(&rotated, &config, caches[i]);
+                    let want = match (cull, core) {
+                        (CullMode::None, _) => 1,
+                        (_, true) => KEPT_WORK,
+                        (_, false) => 1,
+                    };
+                    assert_eq!(work, vec![(n, want)], "{cull:?}: object {i} triangle {k}");
+                }
+            }
+            assert_eq!(kept_some, [cull != CullMode::None, true], "{cull:?}");
         }
     }
 
