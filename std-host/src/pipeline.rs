@@ -449,7 +449,9 @@ where
             }
         }
         let rect = [x0 as u32, x1 as u32, y0 as u32, y1 as u32];
-        let px = f(tile, rect, &mut lc[..n], has_depth.then_some(&mut ld[..n]))?;
+        // (`ld` is empty without depth: not sliced then.)
+        let tile_depth = if has_depth { Some(&mut ld[..n]) } else { None };
+        let px = f(tile, rect, &mut lc[..n], tile_depth)?;
         let mut g = lock(band);
         let (c, d) = &mut *g;
         for r in 0..rows {

@@ -342,6 +342,25 @@ fn tiles_give_the_output_of_strips() {
             }
         }
     }
+    // Without a depth buffer too (tiles narrower than the image used to
+    // slice an empty depth tile and panic).
+    let image = |tag: &str, extra: &[&str]| {
+        let img = tmp(&format!("{tag}.png"));
+        let mut args = vec!["render", "--out", img.to_str().unwrap(), "--depth", "none"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        std::fs::read(img).unwrap()
+    };
+    let base = image("tiles-nodepth", &["--size", "203x150", "--threads", "1"]);
+    for (t, tile) in [("1", "32x32"), ("2", "7x5"), ("2", "1x200")] {
+        let tag = format!("tiles-nodepth-{t}-{}", tile.replace('x', "_"));
+        let a = ["--size", "203x150", "--threads", t, "--tile", tile];
+        assert!(
+            image(&tag, &a) == base,
+            "no depth, {t} threads, tiles {tile}"
+        );
+    }
     for bad in [
         &["--tile", "32x32", "--strip-rows", "8"][..],
         &["--tile", "0x32"],
