@@ -350,9 +350,11 @@ where
         }
         Ok(total)
     };
+    // A worker that panicked left its strip half drawn: the panic goes on
+    // in the caller, as one in the worker on the calling thread does.
     let results: Vec<Result<u64, Error>> = each_on_threads((0..threads).collect(), worker)
         .into_iter()
-        .map(|r| r.unwrap_or(Ok(0)))
+        .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
         .collect();
     let mut total = 0;
     for r in results {
@@ -484,9 +486,11 @@ where
         }
         Ok(total)
     };
+    // A worker that panicked left its tile half drawn: the panic goes on
+    // in the caller, as one in the worker on the calling thread does.
     let results: Vec<Result<u64, Error>> = each_on_threads((0..threads).collect(), worker)
         .into_iter()
-        .map(|r| r.unwrap_or(Ok(0)))
+        .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
         .collect();
     let mut total = 0;
     for r in results {
@@ -986,6 +990,34 @@ mod tests {
     use crate::scene::{clip_tris_scene, cubes_scene, View};
     use microraster::pixelcolor::{Rgb888, RgbColor};
     use microraster::CullMode;
+
+    /// A strip or tile worker that panics on another thread than the
+    /// caller's makes the call panic (it used to count 0 pixels and
+    /// return `Ok`, the image half drawn). The caller's own strips take
+    /// long enough that the other worker takes some of the 16.
+    #[test]
+    fn a_panicking_worker_panics_the_call() {
+        let caller = std::thread::current().id();
+        let f = |_| -> Result<u64, Error> {
+            if std::thread::current().id() == caller {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                Ok(1)
+            } else {
+                panic!("worker");
+            }
+        };
+        let (w, h) = (8usize, 16usize);
+        let strips = std::panic::catch_unwind(|| {
+            let mut color = vec![0u8; w * h];
+            for_each_strip::<u8, u16, _>(&mut color, None, w, 1, 2, |y0, _, _| f(y0))
+        });
+        assert!(strips.is_err(), "strips: {strips:?}");
+        let tiles = std::panic::catch_unwind(|| {
+            let mut color = vec![0u8; w * h];
+            for_each_tile::<u8, u16, _>(&mut color, None, w, (4, 2), 2, false, |t, _, _, _| f(t))
+        });
+        assert!(tiles.is_err(), "tiles: {tiles:?}");
+    }
 
     /// A triangle far beyond the guard band on three sides: clipped into
     /// several, so a run of them overflows the first storage guess.
