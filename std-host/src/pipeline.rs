@@ -301,7 +301,8 @@ type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
 
 /// Calls `f(y0, colour rows, depth rows)` for every strip of `rows` rows of
 /// `width` pixels on `threads` workers taking strips from a shared queue
-/// (inline for one thread) and sums what it returns.
+/// (inline for one thread) and sums what it returns. A worker's panic
+/// goes on in the caller, whichever thread it ran on.
 pub fn for_each_strip<C, T, F>(
     color: &mut [C],
     depth: Option<&mut [T]>,
@@ -378,7 +379,8 @@ type Band<'a, C, T> = Mutex<(&'a mut [C], Option<&'a mut [T]>)>;
 /// the image's own rows ([`for_each_strip`]); narrower ones are drawn into
 /// each worker's own tile buffers (which `f` must clear or draw over: they
 /// hold the image's pixels only when `copy_in`), then copied into the
-/// image.
+/// image. A worker's panic goes on in the caller, as for
+/// [`for_each_strip`].
 #[allow(clippy::too_many_arguments)]
 pub fn for_each_tile<C, T, F>(
     color: &mut [C],
