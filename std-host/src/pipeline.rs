@@ -331,37 +331,7 @@ where
             }
         }
     }
-    if threads <= 1 {
-        let mut total = 0;
-        for (y0, c, d) in work {
-            total += f(y0, c, d)?;
-        }
-        return Ok(total);
-    }
-    let queue = Mutex::new(work.into_iter());
-    let worker = |_| -> Result<u64, Error> {
-        let mut total = 0;
-        loop {
-            let item = match queue.lock() {
-                Ok(mut q) => q.next(),
-                Err(poisoned) => poisoned.into_inner().next(),
-            };
-            let Some((y0, c, d)) = item else { break };
-            total += f(y0, c, d)?;
-        }
-        Ok(total)
-    };
-    // A worker that panicked left its strip half drawn: the panic goes on
-    // in the caller, as one in the worker on the calling thread does.
-    let results: Vec<Result<u64, Error>> = each_on_threads((0..threads).collect(), worker)
-        .into_iter()
-        .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
-        .collect();
-    let mut total = 0;
-    for r in results {
-        total += r?;
-    }
-    Ok(total)
+    drain_on_threads(work, threads, || (), |(y0, c, d), _| f(y0, c, d))
 }
 
 /// One tile for [`for_each_tile`]: its index, its rectangle `[x0, x1, y0,
@@ -466,39 +436,39 @@ where
         }
         Ok(px)
     };
-    if threads <= 1 {
-        let (mut lc, mut ld) = (Vec::new(), Vec::new());
-        let mut total = 0;
-        for item in work {
-            total += one(item, &mut lc, &mut ld)?;
-        }
-        return Ok(total);
-    }
+    let buffers = || (Vec::new(), Vec::new());
+    drain_on_threads(work, threads, buffers, |item, (lc, ld)| one(item, lc, ld))
+}
+
+/// Calls `f(item, state)` for every item of `work` on `threads` workers
+/// taking them in order from a shared queue (inline for one thread), each
+/// with its own `state()`, and sums what it returns; the first error ends
+/// a worker. A worker that panicked left its item half done: the panic
+/// goes on in the caller, as one in the worker on the calling thread does.
+fn drain_on_threads<W: Send, S>(
+    work: Vec<W>,
+    threads: usize,
+    state: impl Fn() -> S + Sync,
+    f: impl Fn(W, &mut S) -> Result<u64, Error> + Sync,
+) -> Result<u64, Error> {
     let queue = Mutex::new(work.into_iter());
     let worker = |_| -> Result<u64, Error> {
-        let (mut lc, mut ld) = (Vec::new(), Vec::new());
+        let mut st = state();
         let mut total = 0;
         loop {
-            let item = match queue.lock() {
-                Ok(mut q) => q.next(),
-                Err(poisoned) => poisoned.into_inner().next(),
+            // (The lock is released before `f` runs.)
+            let Some(item) = lock(&queue).next() else {
+                return Ok(total);
             };
-            let Some(item) = item else { break };
-            total += one(item, &mut lc, &mut ld)?;
+            total += f(item, &mut st)?;
         }
-        Ok(total)
     };
-    // A worker that panicked left its tile half drawn: the panic goes on
-    // in the caller, as one in the worker on the calling thread does.
-    let results: Vec<Result<u64, Error>> = each_on_threads((0..threads).collect(), worker)
+    // Every worker's panic before any worker's error.
+    let results: Vec<Result<u64, Error>> = each_on_threads((0..threads.max(1)).collect(), worker)
         .into_iter()
         .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
         .collect();
-    let mut total = 0;
-    for r in results {
-        total += r?;
-    }
-    Ok(total)
+    results.into_iter().sum()
 }
 
 /// Runs `f` on every item, the first on the calling thread and each other
