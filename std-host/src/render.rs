@@ -5,8 +5,9 @@
 //! into binned core frames (see [`crate::pipeline`]: one frame per setup
 //! thread from 20,000 triangles up, storage sized from the triangle count
 //! and grown only on `Error::StorageFull`), then draws strips of
-//! `strip_rows` rows on `std::thread::scope` workers that take them from one
-//! shared queue, so more strips than threads balance the load; each worker
+//! `strip_rows` rows on `std::thread::scope` workers that take them from a
+//! shared queue (each its own contiguous run first), so more strips than
+//! threads balance the load; each worker
 //! owns its `&mut` rows and clears them before drawing. The triangle-id
 //! image, if asked for, is drawn from the same set-up frames. The core draws
 //! triangles in submission order in every strip, so the image is

@@ -22,7 +22,7 @@
 //! (Blinn-Phong half vector per light, see `microraster::shade`).
 //!
 //! The frame is set up once (one core `Frame`, storage grown on
-//! `StorageFull`), then strips are drawn on the worker threads from the
+//! `StorageFull`), then strips are drawn on the worker threads from a
 //! shared queue, as in [`crate::render`]; the image is identical for any
 //! thread count and strip height.
 
