@@ -1161,6 +1161,21 @@ mod tests {
         }
     }
 
+    /// `scene` rendered by a fresh 64x48 pipeline on `threads` threads:
+    /// the pipeline, and the colour, depth, pixels written and counters.
+    fn render_64x48(
+        scene: &Scene,
+        threads: usize,
+    ) -> (FramePipeline<8>, (Vec<Rgb888>, Vec<u32>, u64, Stats)) {
+        let mut pipe = FramePipeline::<8>::new(config(), threads, 5);
+        let mut color = vec![Rgb888::BLACK; 64 * 48];
+        let mut depth = vec![u32::MAX; 64 * 48];
+        let (setup, _, px) = pipe
+            .render(scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
+            .unwrap();
+        (pipe, (color, depth, px, setup.stats))
+    }
+
     /// A mesh of over [`VERTEX_CHUNK_MIN`] vertices and
     /// [`PARALLEL_SETUP_MIN_TRIANGLES`] triangles (vertex chunks taken by
     /// whichever worker is free, one setup frame per thread, binned by its
@@ -1173,14 +1188,9 @@ mod tests {
         assert!(scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES);
         let mut images = Vec::new();
         for threads in [1, 2, 3] {
-            let mut pipe = FramePipeline::<8>::new(config(), threads, 5);
-            let mut color = vec![Rgb888::BLACK; 64 * 48];
-            let mut depth = vec![u32::MAX; 64 * 48];
-            let (setup, _, px) = pipe
-                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
-                .unwrap();
+            let (pipe, image) = render_64x48(&scene, threads);
             assert_eq!(pipe.storages.len(), threads);
-            images.push((color, depth, px, setup.stats));
+            images.push(image);
         }
         assert!(images[0].2 > 1000, "the sphere is drawn");
         assert!(images.windows(2).all(|w| w[0] == w[1]));
@@ -1392,13 +1402,8 @@ mod tests {
         let scene = clip_tris_scene(tris);
         let mut images = Vec::new();
         for threads in [1, 2, 3] {
-            let mut pipe = FramePipeline::<8>::new(config(), threads, 5);
-            let mut color = vec![Rgb888::BLACK; 64 * 48];
-            let mut depth = vec![u32::MAX; 64 * 48];
-            let (setup, _, px) = pipe
-                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
-                .unwrap();
-            assert_eq!(setup.stats.clipped, 4000);
+            let (pipe, image) = render_64x48(&scene, threads);
+            assert_eq!(image.3.clipped, 4000);
             // With parallel setup the first chunk kept its first guess and
             // the last one grew.
             let guesses: Vec<usize> = partition(&scene, threads)
@@ -1411,7 +1416,7 @@ mod tests {
                 assert_eq!(pipe.storages[0].len(), guesses[0]);
                 assert!(pipe.storages[threads - 1].len() > guesses[threads - 1]);
             }
-            images.push((color, depth, px, setup.stats));
+            images.push(image);
         }
         assert!(images.windows(2).all(|w| w[0] == w[1]));
     }
