@@ -10,7 +10,7 @@
 //! and [`fill`]s each chunk into its own [`Frame`] and setup storage; the
 //! same worker then bins its frame, sorting its triangles by strip into
 //! bins grown to what it counts ([`Frame::bin_tiles_with`]). Each parallel
-//! stage runs one worker on the calling thread ([`each_on_threads`]).
+//! stage runs one worker on the calling thread (`each_on_threads`).
 //! Every frame is set up exactly once:
 //! storage is sized from the triangle count, and only when a chunk reports
 //! [`Error::StorageFull`] (clipping made more triangles than the guess) are
@@ -19,7 +19,7 @@
 //! loop stops allocating after its first frame; `render::render` uses a fresh
 //! one per image. [`draw_layers`] clears and draws strips on `threads`
 //! workers that each take a contiguous run of them first, then help with
-//! the longest run left ([`Runs`]; inline for one thread),
+//! the longest run left (`Runs`; inline for one thread),
 //! or, binned by tile ([`FramePipeline::with_tile_width`]), tiles drawn
 //! into each worker's own tile buffers and copied into the image
 //! ([`for_each_tile`]).
@@ -45,7 +45,7 @@ pub const PARALLEL_SETUP_MIN_TRIANGLES: usize = 20_000;
 /// Vertices per vertex-stage chunk, at least.
 pub const VERTEX_CHUNK_MIN: usize = 4096;
 
-/// Vertex-stage chunks per thread, at most: workers take them as [`Runs`]
+/// Vertex-stage chunks per thread, at most: workers take them as `Runs`
 /// deals them, so a worker that starts late takes fewer.
 pub const VERTEX_CHUNKS_PER_THREAD: usize = 4;
 
@@ -308,7 +308,7 @@ type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
 
 /// Calls `f(y0, colour rows, depth rows)` for every strip of `rows` rows of
 /// `width` pixels on `threads` workers taking strips from a shared queue
-/// ([`Runs`]; inline for one thread) and sums what it returns. A worker's panic
+/// (`Runs`; inline for one thread) and sums what it returns. A worker's panic
 /// goes on in the caller, whichever thread it ran on.
 pub fn for_each_strip<C, T, F>(
     color: &mut [C],
@@ -351,7 +351,7 @@ type Band<'a, C, T> = Mutex<(&'a mut [C], Option<&'a mut [T]>)>;
 /// Calls `f(tile, [x0, x1, y0, y1], colour, depth)` for every tile of
 /// `tile_w x tile_h` (numbered row by row, as [`Frame::bin_tiles`] does) of
 /// an image `width` pixels wide, with buffers that hold exactly the tile,
-/// on `threads` workers taking tiles from a shared queue ([`Runs`]), and
+/// on `threads` workers taking tiles from a shared queue (`Runs`), and
 /// sums what it returns. Tiles at least as wide as the image are strips, handed out as
 /// the image's own rows ([`for_each_strip`]); narrower ones are drawn into
 /// each worker's own tile buffers (which `f` must clear or draw over: they
