@@ -308,8 +308,8 @@ type Work<'a, C, T> = (u32, &'a mut [C], Option<&'a mut [T]>);
 
 /// Calls `f(y0, colour rows, depth rows)` for every strip of `rows` rows of
 /// `width` pixels on `threads` workers taking strips from a shared queue
-/// (`Runs`; inline for one thread) and sums what it returns. A worker's panic
-/// goes on in the caller, whichever thread it ran on.
+/// (`Runs`; inline for one thread) and sums what it returns. A worker's
+/// panic goes on in the caller, whichever thread it ran on.
 pub fn for_each_strip<C, T, F>(
     color: &mut [C],
     depth: Option<&mut [T]>,
@@ -352,9 +352,9 @@ type Band<'a, C, T> = Mutex<(&'a mut [C], Option<&'a mut [T]>)>;
 /// `tile_w x tile_h` (numbered row by row, as [`Frame::bin_tiles`] does) of
 /// an image `width` pixels wide, with buffers that hold exactly the tile,
 /// on `threads` workers taking tiles from a shared queue (`Runs`), and
-/// sums what it returns. Tiles at least as wide as the image are strips, handed out as
-/// the image's own rows ([`for_each_strip`]); narrower ones are drawn into
-/// each worker's own tile buffers (which `f` must clear or draw over: they
+/// sums what it returns. Tiles at least as wide as the image are strips,
+/// handed out as the image's own rows ([`for_each_strip`]); narrower ones
+/// are drawn into each worker's own tile buffers (which `f` must clear or draw over: they
 /// hold the image's pixels only when `copy_in`), then copied into the
 /// image. A worker's panic goes on in the caller, as for
 /// [`for_each_strip`].
