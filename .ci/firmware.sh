@@ -511,7 +511,7 @@ for v in "${mask_variants[@]}"; do
   fi
 done
 
-# Occlusion culling (issue 11) on the M4F: a herd of nine Spots, each
+# Occlusion culling (issue 11) on the M4F: a herd of 100 Spots, each
 # strip drawing them front to back plainly (`herd`) or through an
 # `Occluder` (`herd-occlusion`); both frames must be the herd's host
 # frame (host-checksums.txt `spot-flat-herd`), counts of record in

@@ -396,11 +396,16 @@ impl spot_scene::Draw for HostFrame {
         // With `herd`, every Spot of the herd in its order (ids on from
         // the one before), as the firmware's strips submit them.
         let spots = if cfg!(feature = "herd") {
-            spot_scene::HERD.len()
+            spot_scene::HERD_SPOTS
         } else {
             1
         };
-        let mut storage = vec![SetupTriangle::<N>::EMPTY; mesh.indices.len() * 7 * spots];
+        // Room for every triangle clipped into up to seven (one Spot), or
+        // into two (the herd: its nearest Spot is 1.5 from the eye, far
+        // behind the 0.5 near plane; a full storage fails the build).
+        let per_triangle = if spots == 1 { 7 } else { 2 };
+        let mut storage =
+            vec![SetupTriangle::<N>::EMPTY; mesh.indices.len() * per_triangle * spots];
         let config = Config::new(WIDTH, HEIGHT);
         let mut frame = Frame::<8, N>::with_subpixel_bits(config, &mut storage).unwrap();
         let vp = spot_scene::mvp(WIDTH, HEIGHT);

@@ -53,7 +53,7 @@
 //! `spot_scene.rs`): the model and its texture in flash, immediate mode,
 //! one shading variant per build. With one of them, `clusters` and the
 //! `cull-*` features draw Spot with cluster tests or normal masks, and
-//! `herd` and `herd-occlusion` a herd of nine Spots without and with
+//! `herd` and `herd-occlusion` a herd of 100 Spots without and with
 //! occlusion culling (see `docs/culling.md`). Features `house` and
 //! `house-portals` draw a baked house of rooms and doors without and with
 //! portal culling (`house.rs`). Where the cubes' code is left out, the

@@ -146,9 +146,9 @@ const CULL_NAME: &str = if cfg!(feature = "cull-masks-frame") {
 } else if cfg!(feature = "cull-masks") {
     "in Morton order, normal masks of each strip's rows"
 } else if cfg!(feature = "herd-occlusion") {
-    "a herd of 9, in Morton order, occlusion culling"
+    "a herd of 100 (10x10), in Morton order, occlusion culling"
 } else if cfg!(feature = "herd") {
-    "a herd of 9, in Morton order"
+    "a herd of 100 (10x10), in Morton order"
 } else {
     "in Morton order"
 };
@@ -230,6 +230,11 @@ struct Measured {
     hidden: u64,
     #[cfg_attr(not(feature = "herd"), allow(dead_code))]
     submitted: u64,
+    /// Of `submitted`, those that reached the strip's triangle tests
+    /// (cull, then set up): neither hidden nor skipped as `outside_strip`
+    /// or `culled_object`, with their run or one by one.
+    #[cfg_attr(not(feature = "herd"), allow(dead_code))]
+    reached: u64,
     /// With `clusters`: what the cluster test did (see `ClusterCount`).
     #[cfg(feature = "clusters")]
     clusters: ClusterCount,
@@ -299,7 +304,7 @@ impl Draw for Strips<'_> {
         let strips_start = display.clock.now();
         let drawn_frame = frame(config, &mvp, &drawn, color, depth, display, mesh, fragment);
         let end = display.clock.now();
-        let (hidden, submitted) = drawn_frame.map_or((0, 0), |f| (f.1, f.2));
+        let (hidden, submitted, reached) = drawn_frame.map_or((0, 0, 0), |f| f.1);
         let written = drawn_frame.map(|f| f.0);
 
         let clock = &mut display.clock;
@@ -413,6 +418,7 @@ impl Draw for Strips<'_> {
             one_row,
             hidden,
             submitted,
+            reached,
             #[cfg(feature = "clusters")]
             clusters,
             #[cfg(feature = "cull-masks")]
@@ -522,7 +528,9 @@ impl Default for Sweep {
 
 /// Every strip: clear, submit the mesh to a `StripRenderer` for its rows,
 /// push the rows. The pixels written, and the triangles the strips' tests
-/// hid and were submitted (`Stats::culled_occlusion`, `Stats::submitted`).
+/// hid, were submitted, and reached the triangle tests
+/// (`Stats::culled_occlusion`, `Stats::submitted`, the latter less the
+/// hidden, `outside_strip` and `culled_object`).
 #[allow(clippy::too_many_arguments)]
 // Inlined into each caller (the frame of record and the sweep), so that
 // neither's stack sits on top of an out-of-line copy (+650 B measured).
@@ -536,12 +544,12 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
     display: &mut HashDisplay,
     mesh: &Mesh<'_, A>,
     fragment: F,
-) -> Result<(u64, u64, u64), &'static str> {
+) -> Result<(u64, (u64, u64, u64)), &'static str> {
     let mut written = 0;
     #[cfg(feature = "herd")]
-    let (mut hidden, mut submitted) = (0, 0);
+    let (mut hidden, mut submitted, mut reached) = (0, 0, 0);
     #[cfg(not(feature = "herd"))]
-    let (hidden, submitted) = (0, 0);
+    let (hidden, submitted, reached) = (0, 0, 0);
     let mut y0 = 0;
     while y0 < HEIGHT {
         let y1 = (y0 + STRIP_ROWS as u32).min(HEIGHT);
@@ -559,12 +567,17 @@ fn frame<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
         #[cfg(feature = "herd")]
         {
             let stats = strip.stats();
-            (hidden, submitted) = (hidden + stats.culled_occlusion, submitted + stats.submitted);
+            hidden += stats.culled_occlusion;
+            submitted += stats.submitted;
+            reached += stats.submitted
+                - stats.culled_occlusion
+                - stats.outside_strip
+                - stats.culled_object;
         }
         push(display, y0, y1, color)?;
         y0 = y1;
     }
-    Ok((written, hidden, submitted))
+    Ok((written, (hidden, submitted, reached)))
 }
 
 /// Submits `mesh` as its runs of `CHUNK_TRIANGLES` triangles, each with
@@ -622,7 +635,7 @@ fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
     };
     let bounds = chunks::CHUNKS.iter().zip(chunks::BOXES.iter());
     #[cfg(not(feature = "herd-occlusion"))]
-    for k in 0..spot_scene::HERD.len() {
+    for k in 0..spot_scene::HERD_SPOTS {
         let mvp = *vp * spot_scene::herd_model(k);
         let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
         for (j, (indices, (sphere, _))) in runs.zip(bounds.clone()).enumerate() {
@@ -635,7 +648,7 @@ fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
         use microraster::occlusion::{tiles_for, HiZTile};
         let mut tiles = [HiZTile::default(); tiles_for(WIDTH, STRIP_ROWS as u32)];
         let mut o = strip.occluder(&mut tiles).map_err(|_| "occluder")?;
-        for k in 0..spot_scene::HERD.len() {
+        for k in 0..spot_scene::HERD_SPOTS {
             let mvp = *vp * spot_scene::herd_model(k);
             let whole = (&chunks::WHOLE_SPHERE, &chunks::WHOLE_BOX);
             if o.skips(Some(whole.0), Some(whole.1), &mvp, n as u64) {
@@ -930,12 +943,13 @@ fn main() -> ! {
     {
         let (a, b) = ratio(m.hidden * 100, m.submitted);
         hprintln!(
-            "herd of {} Spots: hidden by occlusion before transform {} of {} triangles submitted to the strips ({}.{} %)",
-            spot_scene::HERD.len(),
+            "herd of {} Spots: hidden by occlusion before transform {} of {} triangles submitted to the strips ({}.{} %); {} reached the strips' triangle tests",
+            spot_scene::HERD_SPOTS,
             m.hidden,
             m.submitted,
             a,
-            b
+            b,
+            m.reached
         );
     }
     #[cfg(feature = "cull-masks")]

@@ -102,49 +102,95 @@ pub fn normal_color(n: Vec3) -> Rgb888 {
 }
 
 /// Object to clip space for a `width x height` frame (45 degree vertical
-/// field of view); with `herd`, world to clip space (each Spot's
-/// [`herd_model`] goes on the right).
+/// field of view); with `herd`, world to clip space (60 degrees, as the
+/// host's `spots` scene; each Spot's [`herd_model`] goes on the right).
 pub fn mvp(width: u32, height: u32) -> Mat4 {
     #[cfg(feature = "herd")]
-    return Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 12.0)
+    return Mat4::perspective(radians(60.0), width as f32 / height as f32, 0.5, 50.0)
         * Mat4::look_at(HERD_EYE, HERD_TARGET, Vec3::new(0.0, 1.0, 0.0));
     #[cfg(not(feature = "herd"))]
     return Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
         * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0));
 }
 
-/// The `herd` builds' Spots, `(x, z)` of each on the ground (Spot's
-/// box is 0.94 wide and 1.72 long): three rows of three, 1.3 apart
-/// across and 2 deep, listed front to back as the camera sees them, so
-/// that the strips draw the nearest first (what occlusion culling needs
-/// to hide the rest).
+/// Spots a side of the `herd` builds' grid: the host's `spots` scene
+/// (`bench --scene spots`, `SPOTS_GRID`), 100 Spots.
 #[allow(dead_code)]
-pub const HERD: [[f32; 2]; 9] = [
-    [0.0, 0.0],
-    [1.3, 0.0],
-    [-1.3, 0.0],
-    [0.0, 2.0],
-    [1.3, 2.0],
-    [-1.3, 2.0],
-    [0.0, 4.0],
-    [1.3, 4.0],
-    [-1.3, 4.0],
-];
+pub const HERD_SIDE: usize = 10;
 
-/// The herd's camera: in front of the first row, a little right of its
-/// middle, at eye height (Spot's back is at about 0.95, its feet at -0.74).
+/// Spots in the herd.
 #[allow(dead_code)]
-pub const HERD_EYE: Vec3 = Vec3::new(0.4, 0.45, -3.2);
+pub const HERD_SPOTS: usize = HERD_SIDE * HERD_SIDE;
+
+/// The grid's spacing between Spots' centres (the host's
+/// `SPOTS_SPACING`; Spot's box is 0.94 wide and 1.72 long).
+#[allow(dead_code)]
+const HERD_SPACING: f32 = 2.0;
+
+/// The herd's camera: the host's `spots_camera(0, 64, 10)`, on a circle
+/// round the grid one spacing outside it, at eye height (Spot's feet at
+/// -0.74, its back at about 0.5), looking at the grid's centre, so the
+/// nearest row hides most of the rows behind it.
+#[allow(dead_code)]
+pub const HERD_EYE: Vec3 = Vec3::new(11.532041, 0.45, 0.566531);
 /// The point the herd's camera looks at: the middle of the herd.
 #[allow(dead_code)]
-pub const HERD_TARGET: Vec3 = Vec3::new(0.0, 0.1, 2.0);
+pub const HERD_TARGET: Vec3 = Vec3::new(0.0, 0.1, 0.0);
 
-/// Object to world space of the herd's Spot `k` (a translation: normals
-/// and lights stay in object space).
+/// Grid cell `c` (row-major) of the herd: its centre `(x, z)` on the
+/// ground and Spot's turn about the vertical axis there, in radians (the
+/// host's `SpotGrid::scene`: the same hash of the cell gives the turn).
+#[allow(dead_code)]
+const fn herd_cell(c: usize) -> (f32, f32, f32) {
+    let half = (HERD_SIDE as f32 - 1.0) * 0.5 * HERD_SPACING;
+    let (i, j) = (c / HERD_SIDE, c % HERD_SIDE);
+    let h = (c as u32).wrapping_mul(2_654_435_761);
+    let yaw = (h >> 8) as f32 / 16_777_216.0 * core::f32::consts::TAU;
+    (
+        i as f32 * HERD_SPACING - half,
+        j as f32 * HERD_SPACING - half,
+        yaw,
+    )
+}
+
+/// The herd's cells front to back as the camera sees them (by the
+/// distance from [`HERD_EYE`] to each cell's centre, ties by cell): the
+/// strips draw the nearest first, what occlusion culling needs to hide the
+/// rest. Sorted at compile time.
+#[allow(dead_code)]
+const HERD_ORDER: [u8; HERD_SPOTS] = {
+    let mut d = [0.0f32; HERD_SPOTS];
+    let mut order = [0u8; HERD_SPOTS];
+    let mut c = 0;
+    while c < HERD_SPOTS {
+        let (x, z, _) = herd_cell(c);
+        let (dx, dz) = (x - HERD_EYE.x, z - HERD_EYE.z);
+        d[c] = dx * dx + dz * dz;
+        order[c] = c as u8;
+        c += 1;
+    }
+    // Insertion sort, stable: equal distances keep the cells' order.
+    let mut a = 1;
+    while a < HERD_SPOTS {
+        let mut b = a;
+        while b > 0 && d[order[b - 1] as usize] > d[order[b] as usize] {
+            let t = order[b - 1];
+            order[b - 1] = order[b];
+            order[b] = t;
+            b -= 1;
+        }
+        a += 1;
+    }
+    order
+};
+
+/// Object to world space of the herd's `k`-th Spot front to back: turned
+/// about the vertical axis, then moved to its cell (normals and lights
+/// stay in object space).
 #[allow(dead_code)]
 pub fn herd_model(k: usize) -> Mat4 {
-    let [x, z] = HERD[k % HERD.len()];
-    Mat4::translation(Vec3::new(x, 0.0, z))
+    let (x, z, yaw) = herd_cell(HERD_ORDER[k % HERD_SPOTS] as usize);
+    Mat4::translation(Vec3::new(x, 0.0, z)) * Mat4::rotation_y(yaw)
 }
 
 /// Cameras of the cluster builds' sweep: eyes on the circle through
