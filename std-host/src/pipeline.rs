@@ -6,7 +6,9 @@
 //! of at least [`VERTEX_CHUNK_MIN`] vertices. The triangle stage splits the
 //! scene's triangle sequence into up to `threads` contiguous [`Piece`]s of
 //! about equal estimated work ([`partition_by`] with a sample of which
-//! triangles culling keeps; one chunk below [`PARALLEL_SETUP_MIN_TRIANGLES`])
+//! triangles culling keeps, a kept one weighed by a cost that each frame
+//! retunes from its chunks' times; one chunk below
+//! [`PARALLEL_SETUP_MIN_TRIANGLES`])
 //! and [`fill`]s each chunk into its own [`Frame`] and setup storage; the
 //! same worker then bins its frame, sorting its triangles by strip into
 //! bins grown to what it counts ([`Frame::bin_tiles_with`]). Each parallel
@@ -36,7 +38,7 @@ use microraster::{
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Triangle counts at and above which the triangle stage is split over the
 /// threads.
@@ -76,21 +78,27 @@ impl Piece {
 /// Splits the scene's triangle sequence into at most `parts` contiguous
 /// chunks of about equal size, in drawing order.
 pub fn partition(scene: &Scene, parts: usize) -> Vec<Vec<Piece>> {
-    partition_by(scene, parts, |o| vec![(scene.objects[o].indices.len(), 1)])
+    partition_by(
+        scene,
+        parts,
+        |o| vec![(scene.objects[o].indices.len(), 1)],
+        1,
+    )
 }
 
 /// Splits the scene's triangle sequence into at most `parts` contiguous
 /// chunks of about equal work, in drawing order. `runs(o)` gives object
 /// `o`'s triangles as consecutive runs `(triangles, work of each)`; a
-/// clip-space triangle is work 1. With every triangle's work 1 this is
-/// [`partition`].
+/// clip-space triangle is work `clip_work`. With every triangle's work 1
+/// this is [`partition`].
 pub fn partition_by(
     scene: &Scene,
     parts: usize,
     runs: impl Fn(usize) -> Vec<(usize, u64)>,
+    clip_work: u64,
 ) -> Vec<Vec<Piece>> {
     let object_runs: Vec<Vec<(usize, u64)>> = (0..scene.objects.len()).map(&runs).collect();
-    let clip_runs = vec![(scene.clip_tris.len(), 1u64)];
+    let clip_runs = vec![(scene.clip_tris.len(), clip_work)];
     let total: u64 = object_runs
         .iter()
         .chain(std::iter::once(&clip_runs))
@@ -159,28 +167,116 @@ pub fn partition_by(
 /// Triangles per sample of [`setup_work`].
 const WORK_SAMPLE: usize = 64;
 
-/// Setup work of a triangle the core keeps (clips, sets up and stores),
-/// in units of one it rejects (a back face or one outside the frustum,
-/// found from three cached vertices): about 77 ns against 24 on the
-/// bunny, from two chunks' times on two threads (21,309 triangles with
-/// 17,286 kept in 1.42 ms, 48,142 with 12,974 kept in 1.83 ms;
-/// 2026-12-06).
-const KEPT_WORK: u64 = 3;
+/// Setup work of a triangle the core rejects (a back face or one outside
+/// the frustum, found from three cached vertices), the unit of the setup
+/// split's estimates: a clip-space or unculled triangle counts as one too.
+const REJECTED_WORK: u64 = 8;
+
+/// The first estimate of a triangle the core keeps (clips, sets up, stores
+/// and bins), in units of [`REJECTED_WORK`]: three rejected ones, from two
+/// chunks' times on two threads before the binning moved into the setup
+/// workers (the bunny: 21,309 triangles with 17,286 kept in 1.42 ms,
+/// 48,142 with 12,974 kept in 1.83 ms; 2026-12-06). Each frame then moves
+/// it towards what its own chunks took ([`SetupSplit`]).
+const KEPT_WORK: u64 = 3 * REJECTED_WORK;
+
+/// The range [`SetupSplit`] keeps the estimate in: a kept triangle
+/// costs from one to sixteen rejected ones.
+const KEPT_WORK_RANGE: (u64, u64) = (REJECTED_WORK, 16 * REJECTED_WORK);
+
+/// How much of the setup chunks' measurements a frame keeps of those
+/// before it ([`SetupSplit`]): about the last eight frames count.
+const FIT_DECAY: f64 = 0.875;
+
+/// The setup split's estimate of a kept triangle's work, retuned from the
+/// times of the chunks that frames with several were set up in.
+#[derive(Clone, Copy, Debug)]
+struct SetupSplit {
+    /// A kept triangle's work in units of [`REJECTED_WORK`]
+    /// ([`KEPT_WORK`] at first).
+    kept_work: u64,
+    /// Least-squares sums over the chunks `(kept k, rejected r, seconds
+    /// d)` of the frames so far, each frame's weight [`FIT_DECAY`] times
+    /// the next one's: `k k`, `k r`, `r r`, `k d`, `r d`.
+    sums: [f64; 5],
+}
+
+impl SetupSplit {
+    fn new() -> Self {
+        SetupSplit {
+            kept_work: KEPT_WORK,
+            sums: [0.0; 5],
+        }
+    }
+
+    /// Adds one frame's chunks, `(kept, rejected, seconds)` each, and moves
+    /// the estimate towards their fit: the chunks' times fitted as `a *
+    /// kept + b * rejected` by least squares over the decayed sums, the
+    /// estimate moved a quarter of the way to `a / b` rejected units
+    /// (rounded away from where it was), by at most an eighth of itself
+    /// (a disturbed frame on a shared machine moves it little), within
+    /// [`KEPT_WORK_RANGE`]. A frame of one chunk, or with a time that is
+    /// not a finite number, adds nothing. The estimate stays within half a
+    /// unit of the fit, where the chunks cannot tell the two costs apart
+    /// (their mixes of kept and rejected triangles nearly alike), and
+    /// where the fit is not positive.
+    fn retune(&mut self, chunks: &[(u64, u64, f64)]) {
+        if chunks.len() < 2 || chunks.iter().any(|c| !c.2.is_finite()) {
+            return;
+        }
+        let mut sums = self.sums.map(|s| s * FIT_DECAY);
+        for &(k, r, d) in chunks {
+            let (k, r) = (k as f64, r as f64);
+            for (s, v) in sums.iter_mut().zip([k * k, k * r, r * r, k * d, r * d]) {
+                *s += v;
+            }
+        }
+        self.sums = sums;
+        let [kk, kr, rr, kd, rd] = sums;
+        let det = kk * rr - kr * kr;
+        // The (kept, rejected) vectors at least some 6 degrees apart.
+        if det.partial_cmp(&(0.01 * kk * rr)) != Some(std::cmp::Ordering::Greater) {
+            return;
+        }
+        let (a, b) = ((kd * rr - rd * kr) / det, (rd * kk - kd * kr) / det);
+        if !(a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0) {
+            return;
+        }
+        let now = self.kept_work as f64;
+        let target = a / b * REJECTED_WORK as f64;
+        if (target - now).abs() < 0.5 {
+            return;
+        }
+        let step = (target - now) / 4.0;
+        let most = (now / 8.0).max(1.0);
+        let moved = now + step.clamp(-most, most);
+        // Rounded away from where it was, so that it reaches the target.
+        let moved = if step > 0.0 {
+            moved.ceil()
+        } else {
+            moved.floor()
+        };
+        let (lo, hi) = KEPT_WORK_RANGE;
+        self.kept_work = (moved as u64).clamp(lo, hi);
+    }
+}
 
 /// Object `o`'s triangles as runs of [`WORK_SAMPLE`] with their estimated
 /// setup work ([`partition_by`]): each run's first triangle, read from the
 /// vertex stage's `cache` (`None`: the object is outside the frustum),
-/// stands for the run, kept (work [`KEPT_WORK`]) unless it is culled as a
-/// back (front) face or lies outside one side of the view. Only the split
-/// among the setup workers depends on it, not the image.
+/// stands for the run, kept (work `kept_work`) unless it is culled as a
+/// back (front) face or lies outside one side of the view (work
+/// [`REJECTED_WORK`]). Only the split among the setup workers depends on
+/// it, not the image.
 fn setup_work(
     o: &crate::scene::Object,
     config: &Config,
     cache: Option<&[ProcessedVertex]>,
+    kept_work: u64,
 ) -> Vec<(usize, u64)> {
     // (Clustered and masked objects have no cache: they are submitted whole.)
     let Some(cache) = cache.filter(|_| config.cull != CullMode::None) else {
-        return vec![(o.indices.len(), 1)];
+        return vec![(o.indices.len(), REJECTED_WORK)];
     };
     let ccw_front = config.front_face == FrontFace::Ccw;
     let kept = |t: &[u32; 3]| {
@@ -213,7 +309,14 @@ fn setup_work(
     };
     o.indices
         .chunks(WORK_SAMPLE)
-        .map(|run| (run.len(), if kept(&run[0]) { KEPT_WORK } else { 1 }))
+        .map(|run| {
+            let work = if kept(&run[0]) {
+                kept_work
+            } else {
+                REJECTED_WORK
+            };
+            (run.len(), work)
+        })
         .collect()
 }
 
@@ -730,14 +833,19 @@ pub struct FramePipeline<const S: u32> {
     caches: Vec<Vec<ProcessedVertex>>,
     storages: Vec<Vec<SetupTriangle>>,
     bins: Vec<BinBuffers>,
+    /// The setup split's estimate of a kept triangle's work, retuned by
+    /// each frame set up in several chunks.
+    split: SetupSplit,
 }
 
 /// One frame's bins: offsets and items (see [`Frame::bin_tiles_with`]).
 type BinBuffers = (Vec<u32>, Vec<u32>);
 
-/// One setup worker's frame, binned, and when its building ended (before
-/// the binning): `Ok(Err(needed))` when its storage is full.
-type Built<'s, 'b, const S: u32> = Result<Result<(Frame<'s, S>, Bins<'b>, Instant), usize>, String>;
+/// One setup worker's frame, binned, when its building ended (before the
+/// binning) and how long building and binning took: `Ok(Err(needed))`
+/// when its storage is full.
+type Built<'s, 'b, const S: u32> =
+    Result<Result<(Frame<'s, S>, Bins<'b>, Instant, Duration), usize>, String>;
 
 /// Builds the frame of `pieces` in `storage` and bins it into tiles of
 /// `tile` (width, height) in `bins`.
@@ -751,12 +859,13 @@ fn build_chunk<'s, 'b, const S: u32>(
     pieces: &[Piece],
     caches: &[Option<&[ProcessedVertex]>],
 ) -> Built<'s, 'b, S> {
+    let start = Instant::now();
     let mut f = Frame::<S>::with_subpixel_bits(config, storage).map_err(|e| e.to_string())?;
     match fill(&mut f, scene, pieces, caches) {
         Ok(()) => {
             let built = Instant::now();
             let b = bin_growing::<S>(&f, tile.0, tile.1, bins)?;
-            Ok(Ok((f, b, built)))
+            Ok(Ok((f, b, built, start.elapsed())))
         }
         Err(Error::StorageFull { needed, .. }) => Ok(Err(needed)),
         Err(e) => Err(e.to_string()),
@@ -892,6 +1001,7 @@ impl<const S: u32> FramePipeline<S> {
             caches: Vec::new(),
             storages: Vec::new(),
             bins: Vec::new(),
+            split: SetupSplit::new(),
         }
     }
 
@@ -942,6 +1052,7 @@ impl<const S: u32> FramePipeline<S> {
             caches,
             storages,
             bins,
+            split,
         } = self;
         let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
         // Strips are tiles as wide as the frame.
@@ -962,9 +1073,8 @@ impl<const S: u32> FramePipeline<S> {
         // of one half (the bunny: 24,744 against 5,516 of 30,260 in two
         // equal halves).
         let chunks = if parts > 1 {
-            partition_by(scene, parts, |i| {
-                setup_work(&scene.objects[i], &config, caches[i])
-            })
+            let runs = |i| setup_work(&scene.objects[i], &config, caches[i], split.kept_work);
+            partition_by(scene, parts, runs, REJECTED_WORK)
         } else {
             partition(scene, 1)
         };
@@ -990,10 +1100,14 @@ impl<const S: u32> FramePipeline<S> {
             let mut frames = Vec::with_capacity(results.len());
             let mut binned = Vec::with_capacity(results.len());
             let mut built_at = t1;
+            let mut took = Vec::with_capacity(results.len());
             let mut grow = vec![0usize; results.len()];
             for (i, r) in results.into_iter().enumerate() {
                 match r? {
-                    Ok((f, b, t)) => {
+                    Ok((f, b, t, d)) => {
+                        let s = f.stats();
+                        let rejected = s.submitted.saturating_sub(s.stored);
+                        took.push((s.stored, rejected, d.as_secs_f64()));
                         frames.push(f);
                         binned.push(b);
                         built_at = built_at.max(t);
@@ -1002,6 +1116,7 @@ impl<const S: u32> FramePipeline<S> {
                 }
             }
             if grow.iter().all(|&g| g == 0) {
+                split.retune(&took);
                 let triangles = built_at.duration_since(t1).as_secs_f64() * 1e3;
                 break (frames, binned, triangles, ms(t1) - triangles);
             }
@@ -1178,7 +1293,8 @@ mod tests {
     /// A mesh of over [`VERTEX_CHUNK_MIN`] vertices and
     /// [`PARALLEL_SETUP_MIN_TRIANGLES`] triangles (vertex chunks taken by
     /// whichever worker is free, one setup frame per thread, binned by its
-    /// worker): the same image, counters and pixels on 1, 2 and 3 threads.
+    /// worker): the same image, counters and pixels on 1, 2 and 3 threads,
+    /// and with any weight of the setup split.
     #[test]
     fn a_mesh_split_over_threads_gives_the_same_image() {
         let view = View::new(64, 48);
@@ -1193,6 +1309,18 @@ mod tests {
         }
         assert!(images[0].2 > 1000, "the sphere is drawn");
         assert!(images.windows(2).all(|w| w[0] == w[1]));
+        // Frames after the first, on a pipeline whose setup split weighs a
+        // kept triangle anywhere in its range: other chunks, the same image.
+        let (mut pipe, _) = render_64x48(&scene, 2);
+        for kept_work in [KEPT_WORK_RANGE.0, KEPT_WORK, KEPT_WORK_RANGE.1] {
+            pipe.split.kept_work = kept_work;
+            let mut color = vec![Rgb888::BLACK; 64 * 48];
+            let mut depth = vec![u32::MAX; 64 * 48];
+            let (setup, _, px) = pipe
+                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
+                .unwrap();
+            assert_eq!((color, depth, px, setup.stats), images[0], "{kept_work}");
+        }
     }
 
     /// A triangle far beyond the guard band on three sides: clipped into
@@ -1281,17 +1409,82 @@ mod tests {
                     // The object with triangle k first.
                     let mut rotated = o.clone();
                     rotated.indices.rotate_left(k);
-                    let work = setup_work(&rotated, &config, caches[i]);
+                    let work = setup_work(&rotated, &config, caches[i], KEPT_WORK);
                     let want = match (cull, core) {
-                        (CullMode::None, _) => 1,
+                        (CullMode::None, _) => REJECTED_WORK,
                         (_, true) => KEPT_WORK,
-                        (_, false) => 1,
+                        (_, false) => REJECTED_WORK,
                     };
                     assert_eq!(work, vec![(n, want)], "{cull:?}: object {i} triangle {k}");
                 }
             }
             assert_eq!(kept_some, [cull != CullMode::None, true], "{cull:?}");
         }
+    }
+
+    /// The estimate moves towards the ratio of the costs that made the
+    /// chunks' times, a bounded step a frame, and converges on it; it
+    /// stays where the chunks cannot tell the costs apart.
+    #[test]
+    fn setup_split_follows_the_measured_costs() {
+        // Times of chunks of (kept, rejected) triangles at `a` and `b`
+        // seconds each.
+        let times = |a: f64, b: f64, chunks: &[(u64, u64)]| -> Vec<(u64, u64, f64)> {
+            chunks
+                .iter()
+                .map(|&(k, r)| (k, r, a * k as f64 + b * r as f64))
+                .collect()
+        };
+        let bunny = [(17_286, 4_023), (12_974, 35_168)];
+        // A kept triangle at 5 rejected ones: 40 units.
+        let at_5 = times(100e-9, 20e-9, &bunny);
+        let mut split = SetupSplit::new();
+        split.retune(&at_5);
+        assert_eq!(split.kept_work, KEPT_WORK + 3);
+        for _ in 0..40 {
+            let k = split.kept_work;
+            split.retune(&at_5);
+            let next = split.kept_work;
+            assert!(next >= k && next - k <= k / 8 + 1, "{k} -> {next}");
+        }
+        assert_eq!(split.kept_work, 5 * REJECTED_WORK);
+        // Then downwards, with three chunks (least squares), as the older
+        // frames fade.
+        let at_2 = times(40e-9, 20e-9, &[(100, 900), (500, 500), (900, 100)]);
+        for _ in 0..100 {
+            split.retune(&at_2);
+        }
+        assert_eq!(split.kept_work, 2 * REJECTED_WORK);
+        // Kept within its range.
+        let mut split = SetupSplit::new();
+        for _ in 0..100 {
+            split.retune(&times(1e-6, 1e-9, &bunny));
+        }
+        assert_eq!(split.kept_work, KEPT_WORK_RANGE.1);
+        let mut split = SetupSplit::new();
+        for _ in 0..100 {
+            split.retune(&times(1e-9, 1e-6, &bunny));
+        }
+        assert_eq!(split.kept_work, KEPT_WORK_RANGE.0);
+        // Unchanged: no chunk or one, alike mixes, nothing rejected, a fit
+        // that is not positive, and times that are not numbers (which are
+        // not kept either).
+        let unchanged: [&[(u64, u64, f64)]; 6] = [
+            &[],
+            &[(17_286, 4_023, 1e-3)],
+            &[(1_000, 1_000, 1e-4), (2_000, 2_010, 2e-4)],
+            &[(1_000, 0, 1e-4), (2_000, 0, 3e-4)],
+            &[(17_286, 4_023, 1e-3), (12_974, 35_168, 1e-6)],
+            &[(17_286, 4_023, f64::NAN), (12_974, 35_168, 1e-3)],
+        ];
+        for chunks in unchanged {
+            let mut split = SetupSplit::new();
+            split.retune(chunks);
+            assert_eq!(split.kept_work, KEPT_WORK, "{chunks:?}");
+        }
+        let mut split = SetupSplit::new();
+        split.retune(&[(1, 1, f64::INFINITY), (1, 2, 1.0)]);
+        assert_eq!(split.sums, [0.0; 5]);
     }
 
     #[test]
@@ -1327,8 +1520,11 @@ mod tests {
         };
         let total = work_of(&partition(&scene, 1).concat());
         for parts in [1, 2, 3, 7, 100] {
-            assert_eq!(partition_by(&scene, parts, unit), partition(&scene, parts));
-            let chunks = partition_by(&scene, parts, uneven);
+            assert_eq!(
+                partition_by(&scene, parts, unit, 1),
+                partition(&scene, parts)
+            );
+            let chunks = partition_by(&scene, parts, uneven, 1);
             assert!(chunks.len() <= parts);
             // In order and whole: each piece starts where the one before
             // it ended or, at a new source, at 0 after the last one ended.
