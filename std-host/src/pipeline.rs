@@ -216,10 +216,10 @@ impl SetupSplit {
     /// (rounded away from where it was), by at most an eighth of itself
     /// (a disturbed frame on a shared machine moves it little), within
     /// [`KEPT_WORK_RANGE`]. A frame of one chunk, or with a time that is
-    /// not a finite number, adds nothing. The estimate stays within half a
-    /// unit of the fit, where the chunks cannot tell the two costs apart
-    /// (their mixes of kept and rejected triangles nearly alike), and
-    /// where the fit is not positive.
+    /// not a finite number, adds nothing. The estimate stays where it is
+    /// when it is within half a unit of the fit, when the chunks cannot
+    /// tell the two costs apart (their mixes of kept and rejected
+    /// triangles nearly alike), and when the fit is not positive.
     fn retune(&mut self, chunks: &[(u64, u64, f64)]) {
         if chunks.len() < 2 || chunks.iter().any(|c| !c.2.is_finite()) {
             return;
