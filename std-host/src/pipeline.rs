@@ -25,6 +25,12 @@
 //! or, binned by tile ([`FramePipeline::with_tile_width`]), tiles drawn
 //! into each worker's own tile buffers and copied into the image
 //! ([`for_each_tile`]).
+//! [`FramePipeline::render`] into strips, with the triangle stage split
+//! over several threads, runs that stage and the drawing in one thread
+//! scope (`render_fused`): each worker sets up and bins its chunk,
+//! publishes its frame, waits at a gate for the others', then draws strips
+//! of every frame; a frame starts one thread fewer, and drawing begins as
+//! the last frame is binned.
 //! Every strip draws the frames in order and the core draws triangles in
 //! submission order, so the image is byte-identical for any thread count and
 //! any strip height.
@@ -37,7 +43,7 @@ use microraster::{
 };
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 /// Triangle counts at and above which the triangle stage is split over the
@@ -426,8 +432,20 @@ where
     T: Send,
     F: Fn(u32, &mut [C], Option<&mut [T]>) -> Result<u64, Error> + Sync,
 {
+    let work = strip_work(color, depth, width, rows);
+    drain_on_threads(work, threads, || (), |(y0, c, d), _| f(y0, c, d))
+}
+
+/// The strips of `rows` rows (at least 1) of an image `width` pixels wide,
+/// in order.
+fn strip_work<'a, C, T>(
+    color: &'a mut [C],
+    depth: Option<&'a mut [T]>,
+    width: usize,
+    rows: usize,
+) -> Vec<Work<'a, C, T>> {
     let rows = rows.max(1);
-    let chunk = width * rows;
+    let chunk = (width * rows).max(1);
     let mut work: Vec<Work<'_, C, T>> = Vec::new();
     match depth {
         Some(d) => {
@@ -441,7 +459,7 @@ where
             }
         }
     }
-    drain_on_threads(work, threads, || (), |(y0, c, d), _| f(y0, c, d))
+    work
 }
 
 /// One tile for [`for_each_tile`]: its index, its rectangle `[x0, x1, y0,
@@ -563,24 +581,32 @@ fn drain_on_threads<W: Send, S>(
 ) -> Result<u64, Error> {
     let threads = threads.max(1);
     let queue = Mutex::new(Runs::new(work, threads));
-    let worker = |w: usize| -> Result<u64, Error> {
-        let mut st = state();
-        let mut total = 0;
-        loop {
-            // (The lock is released before `f` runs.)
-            let item = lock(&queue).take(w);
-            let Some((_, item)) = item else {
-                return Ok(total);
-            };
-            total += f(item, &mut st)?;
-        }
-    };
+    let worker = |w: usize| drain(&queue, w, &mut state(), &f);
     // Every worker's panic before any worker's error.
     let results: Vec<Result<u64, Error>> = each_on_threads((0..threads).collect(), worker)
         .into_iter()
         .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
         .collect();
     results.into_iter().sum()
+}
+
+/// Worker `w`'s share of `queue`: `f(item, state)` for every item it is
+/// dealt, summed; the first error ends it.
+fn drain<W, S>(
+    queue: &Mutex<Runs<W>>,
+    w: usize,
+    state: &mut S,
+    f: impl Fn(W, &mut S) -> Result<u64, Error>,
+) -> Result<u64, Error> {
+    let mut total = 0;
+    loop {
+        // (The lock is released before `f` runs.)
+        let item = lock(queue).take(w);
+        let Some((_, item)) = item else {
+            return Ok(total);
+        };
+        total += f(item, state)?;
+    }
 }
 
 /// Work items dealt out as one contiguous run per worker: a worker takes
@@ -734,37 +760,48 @@ pub fn draw_layers_cleared<const S: u32, C: PixelFormat + Send + Sync, T: DepthW
         tile,
         threads,
         clear.is_none(),
-        |tile, rect, c, mut d| {
-            // Tiles of few, large triangles (a quad, a few boxes) defer
-            // the clear (`LazyClear`): what the layers reach is cleared as
-            // they reach it, the rest after them, so a pixel the first
-            // layer covers is written once, not cleared first. Tiles of
-            // many small triangles (the bunny: about 30 pixels a
-            // triangle) clear first: per row, per triangle, the deferred
-            // clear's bookkeeping costs more than it saves. The pixels
-            // are the same either way (`tests/lazy_clear.rs`).
-            let area = (rect[1] - rect[0]) as usize * (rect[3] - rect[2]) as usize;
-            let items: usize = layers.iter().map(|(_, b)| b.strip_items(tile).len()).sum();
-            let Some(v) = clear else {
-                return draw_tile_layers(layers, tile, c, d, None);
-            };
-            if items * LAZY_PIXELS_PER_TRIANGLE > area {
-                c.fill(v);
-                if let Some(d) = d.as_deref_mut() {
-                    d.fill(depth_clear);
-                }
-                return draw_tile_layers(layers, tile, c, d, None);
-            }
-            let mut hull = vec![0u32; (rect[3] - rect[2]) as usize];
-            let mut lazy = LazyClear::new(&mut hull, rect, v, depth_clear.to_z32())?;
-            let written = draw_tile_layers(layers, tile, c, d.as_deref_mut(), Some(&mut lazy))?;
-            match d {
-                Some(d) => lazy.finish(c, d)?,
-                None => lazy.finish(c, &mut NoDepth)?,
-            };
-            Ok(written)
-        },
+        |tile, rect, c, d| draw_tile_cleared(layers, (tile, rect), c, d, clear, depth_clear),
     )
+}
+
+/// Draws tile `tile` (`[x0, x1, y0, y1]`: `rect`) of every layer in turn
+/// into `c` and `d`, cleared first (colour to `clear`, depth to
+/// `depth_clear`) if `clear` is given; returns the pixels written.
+fn draw_tile_cleared<const S: u32, C: PixelFormat, T: DepthWord>(
+    layers: &[Layer<'_, '_, S>],
+    (tile, rect): (u32, [u32; 4]),
+    c: &mut [C],
+    mut d: Option<&mut [T]>,
+    clear: Option<C>,
+    depth_clear: T,
+) -> Result<u64, Error> {
+    // Tiles of few, large triangles (a quad, a few boxes) defer the clear
+    // (`LazyClear`): what the layers reach is cleared as they reach it, the
+    // rest after them, so a pixel the first layer covers is written once,
+    // not cleared first. Tiles of many small triangles (the bunny: about
+    // 30 pixels a triangle) clear first: per row, per triangle, the
+    // deferred clear's bookkeeping costs more than it saves. The pixels
+    // are the same either way (`tests/lazy_clear.rs`).
+    let area = (rect[1] - rect[0]) as usize * (rect[3] - rect[2]) as usize;
+    let items: usize = layers.iter().map(|(_, b)| b.strip_items(tile).len()).sum();
+    let Some(v) = clear else {
+        return draw_tile_layers(layers, tile, c, d, None);
+    };
+    if items * LAZY_PIXELS_PER_TRIANGLE > area {
+        c.fill(v);
+        if let Some(d) = d.as_deref_mut() {
+            d.fill(depth_clear);
+        }
+        return draw_tile_layers(layers, tile, c, d, None);
+    }
+    let mut hull = vec![0u32; (rect[3] - rect[2]) as usize];
+    let mut lazy = LazyClear::new(&mut hull, rect, v, depth_clear.to_z32())?;
+    let written = draw_tile_layers(layers, tile, c, d.as_deref_mut(), Some(&mut lazy))?;
+    match d {
+        Some(d) => lazy.finish(c, d)?,
+        None => lazy.finish(c, &mut NoDepth)?,
+    };
+    Ok(written)
 }
 
 /// Draws tile `tile` of every layer in turn into `c` and `d` (none: no
@@ -989,6 +1026,52 @@ fn vertex_stage<'c, const S: u32>(
     Ok(out)
 }
 
+/// The vertex stage of `scene` and its triangle sequence split into setup
+/// chunks (see the module documentation), each chunk's storage and bins
+/// ready: each object's processed vertices (as [`vertex_stage`]), the
+/// chunks, and the vertex stage's milliseconds.
+fn prepare<'c, const S: u32>(
+    config: Config,
+    threads: usize,
+    scene: &Scene,
+    caches: &'c mut Vec<Vec<ProcessedVertex>>,
+    (storages, bins): (&mut Vec<Vec<SetupTriangle>>, &mut Vec<BinBuffers>),
+    split: &SetupSplit,
+) -> Result<VertexStage<'c>, String> {
+    let t0 = Instant::now();
+    let caches = vertex_stage::<S>(config, threads, scene, caches)?;
+    let vertex_ms = ms(t0);
+
+    // Triangle stage, in chunks of the scene.
+    let parts = if scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES {
+        threads
+    } else {
+        1
+    };
+    // Chunks of about equal work: kept triangles cost several times
+    // what rejected ones do, and a mesh seen from one side keeps most
+    // of one half (the bunny: 24,744 against 5,516 of 30,260 in two
+    // equal halves).
+    let chunks = if parts > 1 {
+        let runs = |i| setup_work(&scene.objects[i], &config, caches[i], split.kept_work);
+        partition_by(scene, parts, runs, REJECTED_WORK)
+    } else {
+        partition(scene, 1)
+    };
+    storages.resize_with(chunks.len(), Vec::new);
+    for (storage, pieces) in storages.iter_mut().zip(&chunks) {
+        let n: usize = pieces.iter().map(Piece::len).sum();
+        if storage.len() < Frame::<S>::storage_for(n) {
+            storage.resize(Frame::<S>::storage_for(n), SetupTriangle::EMPTY);
+        }
+    }
+    bins.resize_with(chunks.len(), Default::default);
+    Ok((caches, chunks, vertex_ms))
+}
+
+/// What [`prepare`] gives.
+type VertexStage<'c> = (Vec<Option<&'c [ProcessedVertex]>>, Vec<Vec<Piece>>, f64);
+
 impl<const S: u32> FramePipeline<S> {
     /// A pipeline for frames of `config`, on `threads` threads, binned into
     /// strips of `strip_rows` rows.
@@ -1057,34 +1140,9 @@ impl<const S: u32> FramePipeline<S> {
         let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
         // Strips are tiles as wide as the frame.
         let tile_w = if *tile_w == 0 { config.width } else { *tile_w };
-        let t0 = Instant::now();
-        let caches = vertex_stage::<S>(config, threads, scene, caches)?;
+        let (caches, chunks, vertex_ms) =
+            prepare::<S>(config, threads, scene, caches, (storages, bins), split)?;
         let caches = &caches[..];
-        let vertex_ms = ms(t0);
-
-        // Triangle stage, in chunks of the scene.
-        let parts = if scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES {
-            threads
-        } else {
-            1
-        };
-        // Chunks of about equal work: kept triangles cost several times
-        // what rejected ones do, and a mesh seen from one side keeps most
-        // of one half (the bunny: 24,744 against 5,516 of 30,260 in two
-        // equal halves).
-        let chunks = if parts > 1 {
-            let runs = |i| setup_work(&scene.objects[i], &config, caches[i], split.kept_work);
-            partition_by(scene, parts, runs, REJECTED_WORK)
-        } else {
-            partition(scene, 1)
-        };
-        storages.resize_with(chunks.len(), Vec::new);
-        for (storage, pieces) in storages.iter_mut().zip(&chunks) {
-            let n: usize = pieces.iter().map(Piece::len).sum();
-            if storage.len() < Frame::<S>::storage_for(n) {
-                storage.resize(Frame::<S>::storage_for(n), SetupTriangle::EMPTY);
-            }
-        }
         // Every chunk is built (and binned) once. A chunk whose storage
         // was too small (clipping can turn one triangle into several; the
         // first guess almost always suffices) has its storage grown, and
@@ -1092,7 +1150,6 @@ impl<const S: u32> FramePipeline<S> {
         // storage back. The stages' times are those of the last
         // (successful) attempt: triangles until the last worker's frame
         // was built, binning the rest.
-        bins.resize_with(chunks.len(), Default::default);
         let tile = (tile_w, strip_rows);
         let (frames, binned, triangles_ms, binning_ms) = loop {
             let t1 = Instant::now();
@@ -1121,12 +1178,7 @@ impl<const S: u32> FramePipeline<S> {
                 break (frames, binned, triangles, ms(t1) - triangles);
             }
             drop((frames, binned));
-            for (storage, g) in storages.iter_mut().zip(grow) {
-                if g > 0 {
-                    let by = g.max(storage.len() / 2);
-                    storage.resize(storage.len() + by, SetupTriangle::EMPTY);
-                }
-            }
+            grow_storages(storages, &grow);
         };
         let layers: Vec<Layer<'_, '_, S>> = frames.iter().zip(binned.iter()).collect();
         let mut stats = Stats::default();
@@ -1155,6 +1207,12 @@ impl<const S: u32> FramePipeline<S> {
         depth: Option<&mut [T]>,
         clear: C,
     ) -> Result<(SetupTimes, f64, u64), String> {
+        if self.threads > 1
+            && self.tile_w == 0
+            && scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES
+        {
+            return self.render_fused(scene, color, depth, clear);
+        }
         let threads = self.threads;
         let ((raster_ms, px), setup) = self.with_layers(scene, |layers| {
             let t = Instant::now();
@@ -1163,6 +1221,204 @@ impl<const S: u32> FramePipeline<S> {
             Ok((ms(t), px))
         })?;
         Ok((setup, raster_ms, px))
+    }
+}
+
+impl<const S: u32> FramePipeline<S> {
+    /// [`render`](Self::render) of a frame set up by several workers into
+    /// strips, in one thread scope: each worker sets up and bins its chunk
+    /// of the scene, publishes its frame, waits at a [`Gate`] for the
+    /// others' and then draws strips of every frame, as `Runs` deals them
+    /// (the strips and pixels of [`draw_layers`]). A frame of two threads
+    /// thus starts one thread fewer, and its drawing begins when the last
+    /// frame is binned, not after that worker's thread has ended and
+    /// another has started (some 80 us on this 2-core machine). A worker
+    /// that panics or fails still passes the gate; then no strip is drawn
+    /// (and a full storage is grown, the frame built again). Setup times
+    /// are as in [`with_layers`](Self::with_layers), binning until the
+    /// last frame is published; the raster time runs from then.
+    fn render_fused<C: PixelFormat + Send + Sync, T: DepthWord>(
+        &mut self,
+        scene: &Scene,
+        color: &mut [C],
+        mut depth: Option<&mut [T]>,
+        clear: C,
+    ) -> Result<(SetupTimes, f64, u64), String> {
+        let FramePipeline {
+            config,
+            threads,
+            strip_rows,
+            caches,
+            storages,
+            bins,
+            split,
+            ..
+        } = self;
+        let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
+        let (caches, chunks, vertex_ms) =
+            prepare::<S>(config, threads, scene, caches, (storages, bins), split)?;
+        let caches = &caches[..];
+        let tile = (config.width, strip_rows);
+        let width = config.width as usize;
+        loop {
+            let t1 = Instant::now();
+            let n = chunks.len();
+            // Each worker's frame and when it was published.
+            let slots: Vec<OnceLock<(Built<'_, '_, S>, Instant)>> =
+                (0..n).map(|_| OnceLock::new()).collect();
+            let gate = Gate::new(n);
+            let strips = strip_work(color, depth.as_deref_mut(), width, strip_rows as usize);
+            let queue = Mutex::new(Runs::new(strips, n));
+            let work: Vec<SetupWork<'_>> = storages
+                .iter_mut()
+                .map(|s| &mut s[..])
+                .zip(bins.iter_mut())
+                .zip(chunks.iter().map(|c| &c[..]))
+                .enumerate()
+                .collect();
+            let worker = |(w, ((storage, bins), pieces)): (usize, _)| -> Result<u64, Error> {
+                {
+                    let _arrive = gate.arrival();
+                    let built =
+                        build_chunk::<S>(config, storage, bins, tile, scene, pieces, caches);
+                    // (Set once: each slot is this worker's alone.)
+                    let _ = slots[w].set((built, Instant::now()));
+                }
+                gate.wait();
+                let layers: Option<Vec<Layer<'_, '_, S>>> = slots
+                    .iter()
+                    .map(|s| match s.get() {
+                        Some((Ok(Ok((f, b, ..))), _)) => Some((f, b)),
+                        _ => None,
+                    })
+                    .collect();
+                let Some(layers) = layers else {
+                    return Ok(0);
+                };
+                let draw = |(y0, c, d): Work<'_, C, T>, _: &mut ()| {
+                    let y1 = y0 + (c.len() / width.max(1)) as u32;
+                    let rect = [0, config.width, y0, y1];
+                    draw_tile_cleared(&layers, (y0 / strip_rows, rect), c, d, Some(clear), T::FAR)
+                };
+                drain(&queue, w, &mut (), draw)
+            };
+            let drawn: Vec<Result<u64, Error>> = each_on_threads(work, worker)
+                .into_iter()
+                .map(|r| r.unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .collect();
+            let end = Instant::now();
+            let mut grow = vec![0usize; n];
+            let mut took = Vec::with_capacity(n);
+            let mut stats = Stats::default();
+            let (mut built_at, mut published_at) = (t1, t1);
+            for (i, slot) in slots.into_iter().enumerate() {
+                let Some((built, at)) = slot.into_inner() else {
+                    return Err("setup worker failed".into());
+                };
+                match built? {
+                    Ok((f, _, t, d)) => {
+                        let s = f.stats();
+                        let rejected = s.submitted.saturating_sub(s.stored);
+                        took.push((s.stored, rejected, d.as_secs_f64()));
+                        stats += s;
+                        built_at = built_at.max(t);
+                        published_at = published_at.max(at);
+                    }
+                    Err(needed) => grow[i] = needed,
+                }
+            }
+            if grow.iter().any(|&g| g > 0) {
+                grow_storages(storages, &grow);
+                continue;
+            }
+            let px: u64 = drawn
+                .into_iter()
+                .sum::<Result<u64, Error>>()
+                .map_err(|e| e.to_string())?;
+            split.retune(&took);
+            let since = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64() * 1e3;
+            let setup = SetupTimes {
+                vertex_ms,
+                triangles_ms: since(t1, built_at),
+                binning_ms: since(built_at, published_at),
+                stats,
+            };
+            return Ok((setup, since(published_at, end), px));
+        }
+    }
+}
+
+/// One setup worker of [`FramePipeline::render_fused`]: its index, its
+/// storage and bins, and its chunk of the scene.
+type SetupWork<'a> = (
+    usize,
+    ((&'a mut [SetupTriangle], &'a mut BinBuffers), &'a [Piece]),
+);
+
+/// Grows each storage whose chunk needed `grow[i]` more entries (0: it
+/// sufficed) by that, or by half its size if that is more.
+fn grow_storages(storages: &mut [Vec<SetupTriangle>], grow: &[usize]) {
+    for (storage, &g) in storages.iter_mut().zip(grow) {
+        if g > 0 {
+            let by = g.max(storage.len() / 2);
+            storage.resize(storage.len() + by, SetupTriangle::EMPTY);
+        }
+    }
+}
+
+/// Where the workers of [`FramePipeline::render_fused`] wait for one
+/// another between setup and drawing: each arrives once (an
+/// [`Arrival`] dropped, also by a worker that panics), and
+/// [`Gate::wait`] returns once all have. A waiter spins up to
+/// [`SPIN_FOR`] (the others are mostly a few microseconds behind), then
+/// sleeps.
+struct Gate {
+    workers: usize,
+    arrived: AtomicUsize,
+    lock: Mutex<()>,
+    all: Condvar,
+}
+
+/// One worker's arrival at a [`Gate`], counted when dropped.
+struct Arrival<'g>(&'g Gate);
+
+impl Drop for Arrival<'_> {
+    fn drop(&mut self) {
+        let g = self.0;
+        g.arrived.fetch_add(1, Ordering::Release);
+        // Under the lock: a waiter checks the count and sleeps under it,
+        // so it cannot miss this.
+        let _held = lock(&g.lock);
+        g.all.notify_all();
+    }
+}
+
+impl Gate {
+    fn new(workers: usize) -> Self {
+        Gate {
+            workers,
+            arrived: AtomicUsize::new(0),
+            lock: Mutex::new(()),
+            all: Condvar::new(),
+        }
+    }
+
+    fn arrival(&self) -> Arrival<'_> {
+        Arrival(self)
+    }
+
+    fn wait(&self) {
+        let all_in = || self.arrived.load(Ordering::Acquire) >= self.workers;
+        let t = Instant::now();
+        while !all_in() && t.elapsed() < SPIN_FOR {
+            for _ in 0..64 {
+                std::hint::spin_loop();
+            }
+        }
+        let mut held = lock(&self.lock);
+        while !all_in() {
+            held = self.all.wait(held).unwrap_or_else(|p| p.into_inner());
+        }
     }
 }
 
@@ -1273,6 +1529,34 @@ mod tests {
                 assert_eq!(v, i as u32 * 2);
             }
         }
+    }
+
+    /// A [`Gate`] opens once every worker has arrived, also when one
+    /// arrived by panicking (its [`Arrival`] dropped as it unwound), and
+    /// not before: the fused render's workers never wait for a worker that
+    /// is gone, and never draw before every frame is published.
+    #[test]
+    fn a_gate_opens_when_every_worker_has_arrived_or_panicked() {
+        let gate = Gate::new(3);
+        let passed = AtomicUsize::new(0);
+        let out = each_on_threads((0..3).collect(), |i: u32| {
+            {
+                let _arrive = gate.arrival();
+                if i == 1 {
+                    panic!("worker 1");
+                }
+                if i == 2 {
+                    // The others reach the gate first and wait.
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                    assert_eq!(passed.load(Ordering::SeqCst), 0, "opened early");
+                }
+            }
+            gate.wait();
+            passed.fetch_add(1, Ordering::SeqCst);
+        });
+        assert!(out[1].is_err());
+        assert!(out[0].is_ok() && out[2].is_ok(), "{out:?}");
+        assert_eq!(passed.load(Ordering::SeqCst), 2);
     }
 
     /// `scene` rendered by a fresh 64x48 pipeline on `threads` threads:
