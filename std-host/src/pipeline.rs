@@ -44,7 +44,7 @@ use microraster::{
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, OnceLock};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Triangle counts at and above which the triangle stage is split over the
 /// threads.
@@ -103,6 +103,20 @@ pub fn partition_by(
     runs: impl Fn(usize) -> Vec<(usize, u64)>,
     clip_work: u64,
 ) -> Vec<Vec<Piece>> {
+    partition_led(scene, parts, runs, clip_work, 0)
+}
+
+/// [`partition_by`] with the first chunk given `lead` units of work more
+/// (fewer, if negative) than an equal share, the others sharing the rest
+/// equally: the first chunk is the calling thread's, which starts before
+/// the others ([`SetupSplit::rebalance`]).
+fn partition_led(
+    scene: &Scene,
+    parts: usize,
+    runs: impl Fn(usize) -> Vec<(usize, u64)>,
+    clip_work: u64,
+    lead: i64,
+) -> Vec<Vec<Piece>> {
     let object_runs: Vec<Vec<(usize, u64)>> = (0..scene.objects.len()).map(&runs).collect();
     let clip_runs = vec![(scene.clip_tris.len(), clip_work)];
     let total: u64 = object_runs
@@ -113,8 +127,15 @@ pub fn partition_by(
         .sum::<u64>()
         .max(1);
     let per = total.div_ceil(parts.max(1) as u64).max(1);
+    // (With no lead every chunk's share is `per`.)
+    let (first, per) = if lead == 0 || parts < 2 {
+        (per, per)
+    } else {
+        let first = (per as i64).saturating_add(lead).clamp(1, total as i64) as u64;
+        (first, (total - first).div_ceil(parts as u64 - 1).max(1))
+    };
     let mut chunks: Vec<Vec<Piece>> = vec![Vec::new()];
-    let mut room = per;
+    let mut room = first;
     // `whole`: one piece however long (a clustered object is submitted
     // whole: its clusters cover all its triangles).
     let mut push = |runs: &[(usize, u64)], whole: bool, make: &dyn Fn(Range<usize>) -> Piece| {
@@ -200,6 +221,10 @@ const KEPT_WORK_RANGE: (u64, u64) = (REJECTED_WORK, 16 * REJECTED_WORK);
 /// before it ([`SetupSplit`]): about the last eight frames count.
 const FIT_DECAY: f64 = 0.875;
 
+/// [`SetupSplit::rebalance`] moves the first chunk's lead by this fraction
+/// of the frame's estimated setup work a frame.
+const LEAD_STEPS: u64 = 256;
+
 /// The setup split's estimate of a kept triangle's work, retuned from the
 /// times of the chunks that frames with several were set up in.
 #[derive(Clone, Copy, Debug)]
@@ -211,6 +236,10 @@ struct SetupSplit {
     /// d)` of the frames so far, each frame's weight [`FIT_DECAY`] times
     /// the next one's: `k k`, `k r`, `r r`, `k d`, `r d`.
     sums: [f64; 5],
+    /// Work the first chunk (the calling thread's) takes beyond an equal
+    /// share, in the split's units (a rejected triangle is
+    /// [`REJECTED_WORK`]; [`SetupSplit::rebalance`]).
+    lead: i64,
 }
 
 impl SetupSplit {
@@ -218,6 +247,7 @@ impl SetupSplit {
         SetupSplit {
             kept_work: KEPT_WORK,
             sums: [0.0; 5],
+            lead: 0,
         }
     }
 
@@ -232,6 +262,41 @@ impl SetupSplit {
     /// when it is within half a unit of the fit, when the chunks cannot
     /// tell the two costs apart (their mixes of kept and rejected
     /// triangles nearly alike), and when the fit is not positive.
+    /// Moves the first chunk's lead one step ([`LEAD_STEPS`]) towards
+    /// the other chunks' ends, from one frame's chunks `(kept, rejected,
+    /// seconds)` and when each ended (seconds from the stage's start): up
+    /// when the others ended later on average, down when earlier, within a
+    /// quarter of the frame's work. The spawned workers start some 30 us
+    /// after the calling one and took longer for their estimated work
+    /// than it did (the bunny's second chunk ended a median 85-135 us
+    /// after the first, 2026-12-07); a step a frame by the sign of the
+    /// difference settles where the chunks end first about equally often,
+    /// which a frame disturbed by another tenant moves by one step only.
+    /// A frame of one chunk, or with an end that is not a finite number,
+    /// changes nothing.
+    fn rebalance(&mut self, chunks: &[(u64, u64, f64)], ends: &[f64]) {
+        if chunks.len() < 2 || ends.len() != chunks.len() || ends.iter().any(|e| !e.is_finite()) {
+            return;
+        }
+        let total: u64 = chunks
+            .iter()
+            .map(|&(k, r, _)| k * self.kept_work + r * REJECTED_WORK)
+            .sum();
+        let others = ends[1..].iter().sum::<f64>() / (ends.len() - 1) as f64;
+        let late = others - ends[0];
+        if late == 0.0 {
+            return;
+        }
+        let step = (total / LEAD_STEPS).max(1) as i64;
+        let most = (total / 4) as i64;
+        let moved = if late > 0.0 {
+            self.lead + step
+        } else {
+            self.lead - step
+        };
+        self.lead = moved.clamp(-most, most);
+    }
+
     fn retune(&mut self, chunks: &[(u64, u64, f64)]) {
         if chunks.len() < 2 || chunks.iter().any(|c| !c.2.is_finite()) {
             return;
@@ -893,10 +958,10 @@ pub struct FramePipeline<const S: u32> {
 type BinBuffers = (Vec<u32>, Vec<u32>);
 
 /// One setup worker's frame, binned, when its building ended (before the
-/// binning) and how long building and binning took: `Ok(Err(needed))`
+/// binning) and when building began and binning ended: `Ok(Err(needed))`
 /// when its storage is full.
 type Built<'s, 'b, const S: u32> =
-    Result<Result<(Frame<'s, S>, Bins<'b>, Instant, Duration), usize>, String>;
+    Result<Result<(Frame<'s, S>, Bins<'b>, Instant, Range<Instant>), usize>, String>;
 
 /// Builds the frame of `pieces` in `storage` and bins it into tiles of
 /// `tile` (width, height) in `bins`.
@@ -916,7 +981,7 @@ fn build_chunk<'s, 'b, const S: u32>(
         Ok(()) => {
             let built = Instant::now();
             let b = bin_growing::<S>(&f, tile.0, tile.1, bins)?;
-            Ok(Ok((f, b, built, start.elapsed())))
+            Ok(Ok((f, b, built, start..Instant::now())))
         }
         Err(Error::StorageFull { needed, .. }) => Ok(Err(needed)),
         Err(e) => Err(e.to_string()),
@@ -1068,7 +1133,7 @@ fn prepare<'c, const S: u32>(
     // equal halves).
     let chunks = if parts > 1 {
         let runs = |i| setup_work(&scene.objects[i], &config, caches[i], split.kept_work);
-        partition_by(scene, parts, runs, REJECTED_WORK)
+        partition_led(scene, parts, runs, REJECTED_WORK, split.lead)
     } else {
         partition(scene, 1)
     };
@@ -1172,13 +1237,16 @@ impl<const S: u32> FramePipeline<S> {
             let mut binned = Vec::with_capacity(results.len());
             let mut built_at = t1;
             let mut took = Vec::with_capacity(results.len());
+            let mut ends = Vec::with_capacity(results.len());
             let mut grow = vec![0usize; results.len()];
             for (i, r) in results.into_iter().enumerate() {
                 match r? {
-                    Ok((f, b, t, d)) => {
+                    Ok((f, b, t, span)) => {
                         let s = f.stats();
                         let rejected = s.submitted.saturating_sub(s.stored);
-                        took.push((s.stored, rejected, d.as_secs_f64()));
+                        let d = span.end.duration_since(span.start).as_secs_f64();
+                        took.push((s.stored, rejected, d));
+                        ends.push(span.end.duration_since(t1).as_secs_f64());
                         frames.push(f);
                         binned.push(b);
                         built_at = built_at.max(t);
@@ -1187,6 +1255,7 @@ impl<const S: u32> FramePipeline<S> {
                 }
             }
             if grow.iter().all(|&g| g == 0) {
+                split.rebalance(&took, &ends);
                 split.retune(&took);
                 let triangles = built_at.duration_since(t1).as_secs_f64() * 1e3;
                 break (frames, binned, triangles, ms(t1) - triangles);
@@ -1323,6 +1392,7 @@ impl<const S: u32> FramePipeline<S> {
             let end = Instant::now();
             let mut grow = vec![0usize; n];
             let mut took = Vec::with_capacity(n);
+            let mut ends = Vec::with_capacity(n);
             let mut stats = Stats::default();
             let (mut built_at, mut published_at) = (t1, t1);
             for (i, slot) in slots.into_iter().enumerate() {
@@ -1330,10 +1400,12 @@ impl<const S: u32> FramePipeline<S> {
                     return Err("setup worker failed".into());
                 };
                 match built? {
-                    Ok((f, _, t, d)) => {
+                    Ok((f, _, t, span)) => {
                         let s = f.stats();
                         let rejected = s.submitted.saturating_sub(s.stored);
-                        took.push((s.stored, rejected, d.as_secs_f64()));
+                        let d = span.end.duration_since(span.start).as_secs_f64();
+                        took.push((s.stored, rejected, d));
+                        ends.push(span.end.duration_since(t1).as_secs_f64());
                         stats += s;
                         built_at = built_at.max(t);
                         published_at = published_at.max(at);
@@ -1349,6 +1421,7 @@ impl<const S: u32> FramePipeline<S> {
                 .into_iter()
                 .sum::<Result<u64, Error>>()
                 .map_err(|e| e.to_string())?;
+            split.rebalance(&took, &ends);
             split.retune(&took);
             let since = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64() * 1e3;
             let setup = SetupTimes {
@@ -1619,6 +1692,16 @@ mod tests {
                 .unwrap();
             assert_eq!((color, depth, px, setup.stats), images[0], "{kept_work}");
         }
+        // And with the first chunk's lead anywhere, even beyond the work.
+        for lead in [-(1 << 40), -5000, 5000, 1 << 40] {
+            pipe.split.lead = lead;
+            let mut color = vec![Rgb888::BLACK; 64 * 48];
+            let mut depth = vec![u32::MAX; 64 * 48];
+            let (setup, _, px) = pipe
+                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
+                .unwrap();
+            assert_eq!((color, depth, px, setup.stats), images[0], "lead {lead}");
+        }
     }
 
     /// A triangle far beyond the guard band on three sides: clipped into
@@ -1718,6 +1801,53 @@ mod tests {
             }
             assert_eq!(kept_some, [cull != CullMode::None, true], "{cull:?}");
         }
+    }
+
+    /// The first chunk's lead steps up when the other chunks end later,
+    /// down when they end earlier, by the frame's work over
+    /// [`LEAD_STEPS`], within a quarter of the work; a frame of one chunk,
+    /// a tie, or ends that do not fit or are not finite change nothing.
+    /// `partition_led` gives the first chunk that much more work.
+    #[test]
+    fn setup_split_leads_the_chunk_that_ends_first() {
+        let mut split = SetupSplit::new();
+        // Work 1000 * 24 + 1000 * 8 + 1000 * 8 = 40,000 units.
+        let chunks = [(1000, 1000, 1e-3), (0, 1000, 1e-3)];
+        let step = (40_000 / LEAD_STEPS) as i64;
+        split.rebalance(&chunks, &[1.0e-3, 1.1e-3]);
+        assert_eq!(split.lead, step);
+        split.rebalance(&chunks, &[1.0e-3, 0.5e-3]);
+        split.rebalance(&chunks, &[1.0e-3, 0.9e-3]);
+        assert_eq!(split.lead, -step);
+        for nothing in [
+            (&chunks[..1], &[1.0e-3][..]),
+            (&chunks[..], &[1.0e-3][..]),
+            (&chunks[..], &[1.0e-3, 1.0e-3][..]),
+            (&chunks[..], &[1.0e-3, f64::NAN][..]),
+            (&chunks[..], &[f64::INFINITY, 1.0][..]),
+        ] {
+            split.rebalance(nothing.0, nothing.1);
+            assert_eq!(split.lead, -step, "{nothing:?}");
+        }
+        for _ in 0..1000 {
+            split.rebalance(&chunks, &[0.0, 1.0]);
+        }
+        assert_eq!(split.lead, 10_000, "a quarter of the work");
+        // The lead in the partition: the first chunk's share grows by it.
+        let scene = cubes_scene(&View::new(32, 24)).unwrap();
+        let unit = |o: usize| vec![(scene.objects[o].indices.len(), 1)];
+        let total = scene.triangle_count();
+        let first = |lead| -> usize {
+            partition_led(&scene, 2, unit, 1, lead)[0]
+                .iter()
+                .map(Piece::len)
+                .sum()
+        };
+        assert_eq!(first(0), total.div_ceil(2));
+        assert_eq!(first(2), total.div_ceil(2) + 2);
+        assert_eq!(first(-2), total.div_ceil(2) - 2);
+        assert_eq!(first(1 << 40), total);
+        assert_eq!(first(-(1 << 40)), 1);
     }
 
     /// The estimate moves towards the ratio of the costs that made the
