@@ -1148,6 +1148,18 @@ fn prepare<'c, const S: u32>(
     Ok((caches, chunks, vertex_ms))
 }
 
+/// A frame after [`FramePipeline::prepare_frame`]: each object's
+/// processed vertices, the setup chunks, the vertex stage's milliseconds,
+/// and the pipeline's storages, bins and split.
+struct Prepared<'p> {
+    caches: Vec<Option<&'p [ProcessedVertex]>>,
+    chunks: Vec<Vec<Piece>>,
+    vertex_ms: f64,
+    storages: &'p mut Vec<Vec<SetupTriangle>>,
+    bins: &'p mut Vec<BinBuffers>,
+    split: &'p mut SetupSplit,
+}
+
 /// What [`prepare`] gives.
 type VertexStage<'c> = (Vec<Option<&'c [ProcessedVertex]>>, Vec<Vec<Piece>>, f64);
 
@@ -1199,6 +1211,31 @@ impl<const S: u32> FramePipeline<S> {
         self.tile_w
     }
 
+    /// [`prepare`] for this pipeline: the vertex stage of `scene` and its
+    /// setup chunks, with the buffers and the split the triangle stage
+    /// takes on with.
+    fn prepare_frame(&mut self, scene: &Scene) -> Result<Prepared<'_>, String> {
+        let FramePipeline {
+            config,
+            threads,
+            caches,
+            storages,
+            bins,
+            split,
+            ..
+        } = self;
+        let (caches, chunks, vertex_ms) =
+            prepare::<S>(*config, *threads, scene, caches, (storages, bins), split)?;
+        Ok(Prepared {
+            caches,
+            chunks,
+            vertex_ms,
+            storages,
+            bins,
+            split,
+        })
+    }
+
     /// Sets `scene` up (vertex stage, triangle stage, binning) and hands
     /// the binned frames to `then`.
     pub fn with_layers<R>(
@@ -1206,22 +1243,16 @@ impl<const S: u32> FramePipeline<S> {
         scene: &Scene,
         then: impl FnOnce(&[Layer<'_, '_, S>]) -> Result<R, String>,
     ) -> Result<(R, SetupTimes), String> {
-        let FramePipeline {
-            config,
-            threads,
-            strip_rows,
-            tile_w,
-            caches,
-            storages,
-            bins,
-            split,
-        } = self;
-        let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
+        let (config, strip_rows) = (self.config, self.strip_rows);
         // Strips are tiles as wide as the frame.
-        let tile_w = if *tile_w == 0 { config.width } else { *tile_w };
-        let (caches, chunks, vertex_ms) =
-            prepare::<S>(config, threads, scene, caches, (storages, bins), split)?;
-        let caches = &caches[..];
+        let tile_w = if self.tile_w == 0 {
+            config.width
+        } else {
+            self.tile_w
+        };
+        let p = self.prepare_frame(scene)?;
+        let (caches, chunks, vertex_ms) = (&p.caches[..], p.chunks, p.vertex_ms);
+        let (storages, bins, split) = (p.storages, p.bins, p.split);
         // Every chunk is built (and binned) once. A chunk whose storage
         // was too small (clipping can turn one triangle into several; the
         // first guess almost always suffices) has its storage grown, and
@@ -1235,29 +1266,21 @@ impl<const S: u32> FramePipeline<S> {
             let results = build_chunks::<S>(config, (storages, bins), tile, scene, &chunks, caches);
             let mut frames = Vec::with_capacity(results.len());
             let mut binned = Vec::with_capacity(results.len());
-            let mut built_at = t1;
-            let mut took = Vec::with_capacity(results.len());
-            let mut ends = Vec::with_capacity(results.len());
+            let mut tally = Tally::new(t1);
             let mut grow = vec![0usize; results.len()];
             for (i, r) in results.into_iter().enumerate() {
                 match r? {
                     Ok((f, b, t, span)) => {
-                        let s = f.stats();
-                        let rejected = s.submitted.saturating_sub(s.stored);
-                        let d = span.end.duration_since(span.start).as_secs_f64();
-                        took.push((s.stored, rejected, d));
-                        ends.push(span.end.duration_since(t1).as_secs_f64());
+                        tally.add(f.stats(), t, span);
                         frames.push(f);
                         binned.push(b);
-                        built_at = built_at.max(t);
                     }
                     Err(needed) => grow[i] = needed,
                 }
             }
             if grow.iter().all(|&g| g == 0) {
-                split.rebalance(&took, &ends);
-                split.retune(&took);
-                let triangles = built_at.duration_since(t1).as_secs_f64() * 1e3;
+                tally.tune(split);
+                let triangles = tally.built_at.duration_since(t1).as_secs_f64() * 1e3;
                 break (frames, binned, triangles, ms(t1) - triangles);
             }
             drop((frames, binned));
@@ -1327,20 +1350,10 @@ impl<const S: u32> FramePipeline<S> {
         mut depth: Option<&mut [T]>,
         clear: C,
     ) -> Result<(SetupTimes, f64, u64), String> {
-        let FramePipeline {
-            config,
-            threads,
-            strip_rows,
-            caches,
-            storages,
-            bins,
-            split,
-            ..
-        } = self;
-        let (config, threads, strip_rows) = (*config, *threads, *strip_rows);
-        let (caches, chunks, vertex_ms) =
-            prepare::<S>(config, threads, scene, caches, (storages, bins), split)?;
-        let caches = &caches[..];
+        let (config, strip_rows) = (self.config, self.strip_rows);
+        let p = self.prepare_frame(scene)?;
+        let (caches, chunks, vertex_ms) = (&p.caches[..], p.chunks, p.vertex_ms);
+        let (storages, bins, split) = (p.storages, p.bins, p.split);
         let tile = (config.width, strip_rows);
         let width = config.width as usize;
         loop {
@@ -1391,23 +1404,17 @@ impl<const S: u32> FramePipeline<S> {
                 .collect();
             let end = Instant::now();
             let mut grow = vec![0usize; n];
-            let mut took = Vec::with_capacity(n);
-            let mut ends = Vec::with_capacity(n);
+            let mut tally = Tally::new(t1);
             let mut stats = Stats::default();
-            let (mut built_at, mut published_at) = (t1, t1);
+            let mut published_at = t1;
             for (i, slot) in slots.into_iter().enumerate() {
                 let Some((built, at)) = slot.into_inner() else {
                     return Err("setup worker failed".into());
                 };
                 match built? {
                     Ok((f, _, t, span)) => {
-                        let s = f.stats();
-                        let rejected = s.submitted.saturating_sub(s.stored);
-                        let d = span.end.duration_since(span.start).as_secs_f64();
-                        took.push((s.stored, rejected, d));
-                        ends.push(span.end.duration_since(t1).as_secs_f64());
-                        stats += s;
-                        built_at = built_at.max(t);
+                        tally.add(f.stats(), t, span);
+                        stats += f.stats();
                         published_at = published_at.max(at);
                     }
                     Err(needed) => grow[i] = needed,
@@ -1421,8 +1428,8 @@ impl<const S: u32> FramePipeline<S> {
                 .into_iter()
                 .sum::<Result<u64, Error>>()
                 .map_err(|e| e.to_string())?;
-            split.rebalance(&took, &ends);
-            split.retune(&took);
+            tally.tune(split);
+            let built_at = tally.built_at;
             let since = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64() * 1e3;
             let setup = SetupTimes {
                 vertex_ms,
@@ -1441,6 +1448,45 @@ type SetupWork<'a> = (
     usize,
     ((&'a mut [SetupTriangle], &'a mut BinBuffers), &'a [Piece]),
 );
+
+/// What the setup split learns from one frame's chunks, as they are
+/// gathered: each chunk's `(kept, rejected, seconds)` and when it ended
+/// (seconds from `t1`, when the stage began), and when the last chunk's
+/// frame was built (before binning).
+struct Tally {
+    t1: Instant,
+    took: Vec<(u64, u64, f64)>,
+    ends: Vec<f64>,
+    built_at: Instant,
+}
+
+impl Tally {
+    fn new(t1: Instant) -> Self {
+        Tally {
+            t1,
+            took: Vec::new(),
+            ends: Vec::new(),
+            built_at: t1,
+        }
+    }
+
+    /// A chunk with counters `s`, built at `built`, begun and ended at `span`.
+    fn add(&mut self, s: Stats, built: Instant, span: Range<Instant>) {
+        let rejected = s.submitted.saturating_sub(s.stored);
+        let secs = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64();
+        self.took
+            .push((s.stored, rejected, secs(span.start, span.end)));
+        self.ends.push(secs(self.t1, span.end));
+        self.built_at = self.built_at.max(built);
+    }
+
+    /// Moves `split` by this frame ([`SetupSplit::rebalance`], then
+    /// [`SetupSplit::retune`]).
+    fn tune(&self, split: &mut SetupSplit) {
+        split.rebalance(&self.took, &self.ends);
+        split.retune(&self.took);
+    }
+}
 
 /// Grows each storage whose chunk needed `grow[i]` more entries (0: it
 /// sufficed) by that, or by half its size if that is more.
@@ -1683,24 +1729,19 @@ mod tests {
         // Frames after the first, on a pipeline whose setup split weighs a
         // kept triangle anywhere in its range: other chunks, the same image.
         let (mut pipe, _) = render_64x48(&scene, 2);
-        for kept_work in [KEPT_WORK_RANGE.0, KEPT_WORK, KEPT_WORK_RANGE.1] {
-            pipe.split.kept_work = kept_work;
-            let mut color = vec![Rgb888::BLACK; 64 * 48];
-            let mut depth = vec![u32::MAX; 64 * 48];
-            let (setup, _, px) = pipe
-                .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
-                .unwrap();
-            assert_eq!((color, depth, px, setup.stats), images[0], "{kept_work}");
-        }
         // And with the first chunk's lead anywhere, even beyond the work.
-        for lead in [-(1 << 40), -5000, 5000, 1 << 40] {
+        let weights = [KEPT_WORK_RANGE.0, KEPT_WORK, KEPT_WORK_RANGE.1].map(|k| (k, 0));
+        let leads = [-(1 << 40), -5000, 5000, 1 << 40].map(|lead| (KEPT_WORK, lead));
+        for (kept_work, lead) in weights.into_iter().chain(leads) {
+            pipe.split.kept_work = kept_work;
             pipe.split.lead = lead;
             let mut color = vec![Rgb888::BLACK; 64 * 48];
             let mut depth = vec![u32::MAX; 64 * 48];
             let (setup, _, px) = pipe
                 .render(&scene, &mut color, Some(&mut depth[..]), Rgb888::BLACK)
                 .unwrap();
-            assert_eq!((color, depth, px, setup.stats), images[0], "lead {lead}");
+            let at = format!("weight {kept_work}, lead {lead}");
+            assert_eq!((color, depth, px, setup.stats), images[0], "{at}");
         }
     }
 
