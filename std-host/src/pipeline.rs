@@ -251,17 +251,6 @@ impl SetupSplit {
         }
     }
 
-    /// Adds one frame's chunks, `(kept, rejected, seconds)` each, and moves
-    /// the estimate towards their fit: the chunks' times fitted as `a *
-    /// kept + b * rejected` by least squares over the decayed sums, the
-    /// estimate moved a quarter of the way to `a / b` rejected units
-    /// (rounded away from where it was), by at most an eighth of itself
-    /// (a disturbed frame on a shared machine moves it little), within
-    /// [`KEPT_WORK_RANGE`]. A frame of one chunk, or with a time that is
-    /// not a finite number, adds nothing. The estimate stays where it is
-    /// when it is within half a unit of the fit, when the chunks cannot
-    /// tell the two costs apart (their mixes of kept and rejected
-    /// triangles nearly alike), and when the fit is not positive.
     /// Moves the first chunk's lead one step ([`LEAD_STEPS`]) towards
     /// the other chunks' ends, from one frame's chunks `(kept, rejected,
     /// seconds)` and when each ended (seconds from the stage's start): up
@@ -297,6 +286,17 @@ impl SetupSplit {
         self.lead = moved.clamp(-most, most);
     }
 
+    /// Adds one frame's chunks, `(kept, rejected, seconds)` each, and moves
+    /// the estimate towards their fit: the chunks' times fitted as `a *
+    /// kept + b * rejected` by least squares over the decayed sums, the
+    /// estimate moved a quarter of the way to `a / b` rejected units
+    /// (rounded away from where it was), by at most an eighth of itself
+    /// (a disturbed frame on a shared machine moves it little), within
+    /// [`KEPT_WORK_RANGE`]. A frame of one chunk, or with a time that is
+    /// not a finite number, adds nothing. The estimate stays where it is
+    /// when it is within half a unit of the fit, when the chunks cannot
+    /// tell the two costs apart (their mixes of kept and rejected
+    /// triangles nearly alike), and when the fit is not positive.
     fn retune(&mut self, chunks: &[(u64, u64, f64)]) {
         if chunks.len() < 2 || chunks.iter().any(|c| !c.2.is_finite()) {
             return;
