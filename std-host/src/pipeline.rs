@@ -1333,9 +1333,10 @@ impl<const S: u32> FramePipeline<S> {
 impl<const S: u32> FramePipeline<S> {
     /// [`render`](Self::render) of a frame set up by several workers into
     /// strips, in one thread scope: each worker sets up and bins its chunk
-    /// of the scene, publishes its frame, waits at a [`Gate`] for the
-    /// others' and then draws strips of every frame, as `Runs` deals them
-    /// (the strips and pixels of [`draw_layers`]). A frame of two threads
+    /// of the scene (a worker beyond the chunks, none), publishes its
+    /// frame, waits at a [`Gate`] for the others' and then draws strips of
+    /// every frame, as `Runs` deals them (the strips and pixels of
+    /// [`draw_layers`]). A frame of two threads
     /// thus starts one thread fewer, and its drawing begins when the last
     /// frame is binned, not after that worker's thread has ended and
     /// another has started (some 80 us on this 2-core machine). A worker
@@ -1350,7 +1351,7 @@ impl<const S: u32> FramePipeline<S> {
         mut depth: Option<&mut [T]>,
         clear: C,
     ) -> Result<(SetupTimes, f64, u64), String> {
-        let (config, strip_rows) = (self.config, self.strip_rows);
+        let (config, strip_rows, threads) = (self.config, self.strip_rows, self.threads);
         let p = self.prepare_frame(scene)?;
         let (caches, chunks, vertex_ms) = (&p.caches[..], p.chunks, p.vertex_ms);
         let (storages, bins, split) = (p.storages, p.bins, p.split);
@@ -1364,16 +1365,23 @@ impl<const S: u32> FramePipeline<S> {
                 (0..n).map(|_| OnceLock::new()).collect();
             let gate = Gate::new(n);
             let strips = strip_work(color, depth.as_deref_mut(), width, strip_rows as usize);
-            let queue = Mutex::new(Runs::new(strips, n));
+            // Every thread draws; a scene cut into fewer chunks than threads
+            // (a clustered object is one piece) leaves the last ones
+            // nothing to set up.
+            let workers = threads.max(n);
+            let queue = Mutex::new(Runs::new(strips, workers));
             let work: Vec<SetupWork<'_>> = storages
                 .iter_mut()
                 .map(|s| &mut s[..])
                 .zip(bins.iter_mut())
                 .zip(chunks.iter().map(|c| &c[..]))
+                .map(Some)
+                .chain(std::iter::repeat_with(|| None))
+                .take(workers)
                 .enumerate()
                 .collect();
-            let worker = |(w, ((storage, bins), pieces)): (usize, _)| -> Result<u64, Error> {
-                {
+            let worker = |(w, job): (usize, Option<_>)| -> Result<u64, Error> {
+                if let Some(((storage, bins), pieces)) = job {
                     let _arrive = gate.arrival();
                     let built =
                         build_chunk::<S>(config, storage, bins, tile, scene, pieces, caches);
@@ -1442,11 +1450,11 @@ impl<const S: u32> FramePipeline<S> {
     }
 }
 
-/// One setup worker of [`FramePipeline::render_fused`]: its index, its
-/// storage and bins, and its chunk of the scene.
+/// One worker of [`FramePipeline::render_fused`]: its index and, if it
+/// sets up a chunk, its storage and bins and its chunk of the scene.
 type SetupWork<'a> = (
     usize,
-    ((&'a mut [SetupTriangle], &'a mut BinBuffers), &'a [Piece]),
+    Option<((&'a mut [SetupTriangle], &'a mut BinBuffers), &'a [Piece])>,
 );
 
 /// What the setup split learns from one frame's chunks, as they are
@@ -1500,8 +1508,8 @@ fn grow_storages(storages: &mut [Vec<SetupTriangle>], grow: &[usize]) {
 }
 
 /// Where the workers of [`FramePipeline::render_fused`] wait for one
-/// another between setup and drawing: each arrives once (an
-/// [`Arrival`] dropped, also by a worker that panics), and
+/// another between setup and drawing: each that sets up a chunk arrives
+/// once (an [`Arrival`] dropped, also by a worker that panics), and
 /// [`Gate::wait`] returns once all have. A waiter spins up to
 /// [`SPIN_FOR`] (the others are mostly a few microseconds behind), then
 /// sleeps.
@@ -1742,6 +1750,25 @@ mod tests {
                 .unwrap();
             let at = format!("weight {kept_work}, lead {lead}");
             assert_eq!((color, depth, px, setup.stats), images[0], "{at}");
+        }
+    }
+
+    /// A clustered mesh is one setup chunk (submitted whole), fewer than
+    /// the threads: the other threads only draw, and the image is the
+    /// one thread's.
+    #[test]
+    fn fewer_setup_chunks_than_threads_give_the_same_image() {
+        let view = View::new(64, 48);
+        let (mut scene, _) = crate::bench_scenes::sphere_scene(&view, 100, 100).unwrap();
+        let cull = microraster::ClusterCull::default();
+        crate::cluster::cluster_scene(&mut scene, cull, &Default::default()).unwrap();
+        assert!(scene.triangle_count() >= PARALLEL_SETUP_MIN_TRIANGLES);
+        let (_, one) = render_64x48(&scene, 1);
+        assert!(one.2 > 1000, "the sphere is drawn");
+        for threads in [2, 3] {
+            let (pipe, image) = render_64x48(&scene, threads);
+            assert_eq!(pipe.storages.len(), 1, "one chunk");
+            assert!(image == one, "{threads} threads");
         }
     }
 
