@@ -525,6 +525,12 @@ pub struct BenchArgs {
     #[arg(long, conflicts_with = "threads")]
     pub scaling: bool,
 
+    /// Time the thread counts of a scaling run one after another, each
+    /// count's frames together, instead of interleaved frame by frame (the
+    /// default, so that a change in the machine's load meets every count).
+    #[arg(long)]
+    pub sequential: bool,
+
     /// Rows per strip.
     #[arg(long, value_name = "R", default_value = "16", value_parser = parse_strip_rows)]
     pub strip_rows: u32,

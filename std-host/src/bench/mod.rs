@@ -19,7 +19,12 @@
 //!
 //! - `scaling`: with `--threads 1,2,4` (a list) or `--scaling` (1..=cores),
 //!   one run per thread count, the speedup over the first, and whether
-//!   every run's last frame has the same checksum (it must).
+//!   every run's last frame has the same checksum (it must). The counts
+//!   take turns frame by frame (frame `k` at 1, 2 and 4 threads, then
+//!   frame `k + 1`), so that a change in the load of this shared machine
+//!   meets them all; `paired_speedup` gives the quartiles of the
+//!   frame-by-frame ratios. `--sequential` runs each count's frames
+//!   together instead.
 //! - `split`: for scenes with meshes (skip with `--no-split`), one thread:
 //!   transform, outcodes and snapping, cull/clip/setup, binning, clear,
 //!   traversal, depth and shade/write,
@@ -81,6 +86,9 @@ pub struct Settings {
     pub height: u32,
     /// Thread counts, one run each (the first is the headline run).
     pub threads: Vec<usize>,
+    /// Time several thread counts frame by frame in turn (frame `k` at
+    /// every count before frame `k + 1`), not one run after another.
+    pub interleave: bool,
     /// Rows per strip (or tile).
     pub strip_rows: u32,
     /// Tile width (0: strips).
@@ -133,6 +141,7 @@ pub fn settings(args: &BenchArgs, name: Option<&str>) -> Settings {
         width: w,
         height: h,
         threads,
+        interleave: !args.sequential,
         strip_rows: args.tile.map_or(args.strip_rows, |t| t.1),
         tile_width: args.tile.map_or(0, |t| t.0),
         cull: match args.cull {
@@ -247,6 +256,20 @@ pub struct Report {
     pub image: Option<Vec<u8>>,
 }
 
+/// The quartiles (25th, 50th, 75th percentile, nearest rank) of
+/// `base[k] / other[k]`, the speed-up of frame `k` against the same frame
+/// of the base run. For interleaved runs, where frame `k` of every thread
+/// count ran one after another and so met the same load.
+pub fn paired_speedup(base: &[f64], other: &[f64]) -> [f64; 3] {
+    let mut r: Vec<f64> = base.iter().zip(other).map(|(b, o)| b / o).collect();
+    if r.is_empty() {
+        return [f64::NAN; 3];
+    }
+    r.sort_by(f64::total_cmp);
+    let at = |q: f64| r[((r.len() - 1) as f64 * q).round() as usize];
+    [at(0.25), median(&r), at(0.75)]
+}
+
 /// Benchmarks `bs` as `s` says.
 pub fn bench(bs: &mut BenchScene, s: &Settings) -> Result<Report, String> {
     if s.threads.is_empty() {
@@ -300,7 +323,7 @@ pub fn bench(bs: &mut BenchScene, s: &Settings) -> Result<Report, String> {
         let mut scaling = serde_json::Map::new();
         for r in runs {
             let ms = median(&r.total);
-            let e = json!({
+            let mut e = json!({
                 "threads": r.threads,
                 "median_ms": ms,
                 "min_ms": min(&r.total),
@@ -313,8 +336,23 @@ pub fn bench(bs: &mut BenchScene, s: &Settings) -> Result<Report, String> {
                 "efficiency": base_ms / ms / (r.threads as f64 / base.threads as f64),
                 "checksum": format!("{:016x}", r.checksum),
             });
+            if s.interleave {
+                let q = paired_speedup(&base.total, &r.total);
+                e["paired_speedup"] = json!({"median": q[1], "p25": q[0], "p75": q[2]});
+            }
             scaling.insert(r.threads.to_string(), e);
         }
+        scaling.insert(
+            "method".into(),
+            json!(if s.interleave {
+                "interleaved: frame k at every thread count in turn, each count with its own \
+                 pipeline and buffers; speedup is the ratio of the medians, paired_speedup the \
+                 quartiles of the frame-by-frame ratios (base frame k over this count's frame k)"
+            } else {
+                "sequential (--sequential): each thread count's frames in one run after the \
+                 previous count's; speedup is the ratio of the medians"
+            }),
+        );
         scaling.insert("speedup_base_threads".into(), json!(base.threads));
         scaling.insert("available_cores".into(), json!(default_threads()));
         let identical = runs.iter().all(|r| r.checksum == first.checksum);
@@ -610,6 +648,59 @@ mod tests {
             assert_eq!(text.matches(&sum).count(), 2, "{scene}: {sum} in {text}");
             assert_eq!(r.image.unwrap(), want.rgb);
         }
+    }
+
+    #[test]
+    fn paired_speedups_are_quartiles_of_frame_ratios() {
+        let base = [4.0, 8.0, 6.0, 10.0, 2.0];
+        let other = [2.0, 2.0, 3.0, 10.0, 2.0];
+        // Ratios 2, 4, 2, 1, 1: sorted 1, 1, 2, 2, 4.
+        assert_eq!(paired_speedup(&base, &other), [1.0, 2.0, 2.0]);
+        assert!(paired_speedup(&[], &[]).iter().all(|q| q.is_nan()));
+    }
+
+    #[test]
+    fn interleaved_and_sequential_scaling_draw_the_same_frames() {
+        // A spinning scene: every thread count must draw the last frame's
+        // matrix whichever way the frames are ordered.
+        let mut images = Vec::new();
+        for extra in [&[][..], &["--sequential"], &["--threads", "1"]] {
+            let mut a = vec![
+                "--scene",
+                "cubes",
+                "--size",
+                "96x72",
+                "--frames",
+                "3",
+                "--warmup",
+                "1",
+                "--spin",
+                "7",
+                "--no-split",
+            ];
+            if !extra.contains(&"--threads") {
+                a.extend_from_slice(&["--threads", "1,2,3"]);
+            }
+            a.extend_from_slice(extra);
+            let a = args(&a);
+            let s = settings(&a, Some("cubes"));
+            assert_eq!(s.interleave, !extra.contains(&"--sequential"));
+            let mut bs = load(&a, &s).unwrap();
+            let r = bench(&mut bs, &s).unwrap();
+            if s.threads.len() > 1 {
+                let sc = &r.json["scaling"];
+                assert_eq!(sc["identical_output"], true, "{sc}");
+                assert_eq!(sc["3"]["checksum"], sc["1"]["checksum"], "{sc}");
+                assert_eq!(sc["3"]["paired_speedup"].is_object(), s.interleave, "{sc}");
+                assert!(sc["method"].as_str().unwrap().starts_with(if s.interleave {
+                    "interleaved"
+                } else {
+                    "sequential"
+                }));
+            }
+            images.push(r.image.unwrap());
+        }
+        assert!(images.windows(2).all(|w| w[0] == w[1]));
     }
 
     #[test]

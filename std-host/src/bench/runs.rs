@@ -115,10 +115,14 @@ pub fn bench_with<const S: u32, C: BenchColor, T: DepthWord>(
 ) -> Result<Formats, String> {
     let mut runs = Vec::new();
     let n = s.threads.len();
-    for (i, &threads) in s.threads.iter().enumerate() {
-        let what = format!("run {}/{n} ({threads} threads)", i + 1);
-        let run = run_frames::<S, C, T>(bs, s, depth_on, threads, i == 0, &what, progress)?;
-        runs.push(run);
+    if s.interleave && n > 1 {
+        runs = run_interleaved::<S, C, T>(bs, s, depth_on, progress)?;
+    } else {
+        for (i, &threads) in s.threads.iter().enumerate() {
+            let what = format!("run {}/{n} ({threads} threads)", i + 1);
+            let run = run_frames::<S, C, T>(bs, s, depth_on, threads, i == 0, &what, progress)?;
+            runs.push(run);
+        }
     }
     let image = runs.first_mut().and_then(|r| r.image.take());
     let render_fn = if s.render_fn {
@@ -286,33 +290,88 @@ pub fn run_frames<const S: u32, C: BenchColor, T: DepthWord>(
     what: &str,
     progress: &mut Progress,
 ) -> Result<Run, String> {
-    let mut pipe =
-        FramePipeline::<S>::new(config_of(s), threads, s.strip_rows).with_tile_width(s.tile_width);
-    let len = s.width as usize * s.height as usize;
-    let mut color = vec![C::CLEAR; len];
-    let mut depth = vec![T::FAR; if depth_on { len } else { 0 }];
-    let mut run = Run {
-        threads,
-        total: Vec::new(),
-        setup: Vec::new(),
-        vertex: Vec::new(),
-        triangles: Vec::new(),
-        binning: Vec::new(),
-        raster: Vec::new(),
-        pixels_written: 0,
-        stats: Stats::default(),
-        checksum: 0,
-        covered: 0,
-        image: None,
-    };
+    let mut t = Timed::<S, C, T>::new(s, depth_on, threads);
     for k in 0..s.warmup + s.frames {
         progress.tick(what, k, s.warmup + s.frames);
+        t.frame(bs, k, k >= s.warmup)?;
+    }
+    Ok(t.finish(keep_image))
+}
+
+/// Times `s.warmup + s.frames` frames at each of `s.threads`, interleaved:
+/// frame `k` at every thread count, in the list's order, before frame
+/// `k + 1` at any. Each count keeps its own pipeline and buffers, as in
+/// [`run_frames`]; the first run keeps its image.
+pub fn run_interleaved<const S: u32, C: BenchColor, T: DepthWord>(
+    bs: &mut BenchScene,
+    s: &Settings,
+    depth_on: bool,
+    progress: &mut Progress,
+) -> Result<Vec<Run>, String> {
+    let mut timed: Vec<Timed<S, C, T>> = s
+        .threads
+        .iter()
+        .map(|&threads| Timed::new(s, depth_on, threads))
+        .collect();
+    let what = format!("{} thread counts, interleaved", s.threads.len());
+    for k in 0..s.warmup + s.frames {
+        progress.tick(&what, k, s.warmup + s.frames);
+        for t in &mut timed {
+            t.frame(bs, k, k >= s.warmup)?;
+        }
+    }
+    Ok(timed
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| t.finish(i == 0))
+        .collect())
+}
+
+/// One thread count's pipeline, buffers and measurements, frame by frame.
+struct Timed<const S: u32, C: BenchColor, T: DepthWord> {
+    pipe: FramePipeline<S>,
+    color: Vec<C>,
+    depth: Vec<T>,
+    depth_on: bool,
+    run: Run,
+}
+
+impl<const S: u32, C: BenchColor, T: DepthWord> Timed<S, C, T> {
+    fn new(s: &Settings, depth_on: bool, threads: usize) -> Self {
+        let len = s.width as usize * s.height as usize;
+        Timed {
+            pipe: FramePipeline::<S>::new(config_of(s), threads, s.strip_rows)
+                .with_tile_width(s.tile_width),
+            color: vec![C::CLEAR; len],
+            depth: vec![T::FAR; if depth_on { len } else { 0 }],
+            depth_on,
+            run: Run {
+                threads,
+                total: Vec::new(),
+                setup: Vec::new(),
+                vertex: Vec::new(),
+                triangles: Vec::new(),
+                binning: Vec::new(),
+                raster: Vec::new(),
+                pixels_written: 0,
+                stats: Stats::default(),
+                checksum: 0,
+                covered: 0,
+                image: None,
+            },
+        }
+    }
+
+    /// Renders frame `k` (the scene's matrix set before the clock starts),
+    /// keeping its times if `timed`.
+    fn frame(&mut self, bs: &mut BenchScene, k: u32, timed: bool) -> Result<(), String> {
         bs.set_frame(k);
         let t0 = Instant::now();
-        let d = depth_on.then_some(&mut depth[..]);
-        let (setup, raster_ms, px) = pipe.render(&bs.scene, &mut color, d, C::CLEAR)?;
+        let d = self.depth_on.then_some(&mut self.depth[..]);
+        let (setup, raster_ms, px) = self.pipe.render(&bs.scene, &mut self.color, d, C::CLEAR)?;
         let frame_ms = ms(t0);
-        if k >= s.warmup {
+        let run = &mut self.run;
+        if timed {
             run.total.push(frame_ms);
             run.setup.push(setup.total_ms());
             run.vertex.push(setup.vertex_ms);
@@ -321,18 +380,26 @@ pub fn run_frames<const S: u32, C: BenchColor, T: DepthWord>(
             run.raster.push(raster_ms);
         }
         (run.pixels_written, run.stats) = (px, setup.stats);
+        Ok(())
     }
-    let rgb: Vec<u8> = color
-        .iter()
-        .flat_map(|c| {
-            let c = c.rgb888();
-            [c.r(), c.g(), c.b()]
-        })
-        .collect();
-    run.checksum = fnv1a64(&rgb);
-    run.covered = color.iter().filter(|&&c| c != C::CLEAR).count() as u64;
-    run.image = keep_image.then_some(rgb);
-    Ok(run)
+
+    /// The run, with the last frame's checksum, coverage and (if asked)
+    /// image.
+    fn finish(self, keep_image: bool) -> Run {
+        let mut run = self.run;
+        let rgb: Vec<u8> = self
+            .color
+            .iter()
+            .flat_map(|c| {
+                let c = c.rgb888();
+                [c.r(), c.g(), c.b()]
+            })
+            .collect();
+        run.checksum = fnv1a64(&rgb);
+        run.covered = self.color.iter().filter(|&&c| c != C::CLEAR).count() as u64;
+        run.image = keep_image.then_some(rgb);
+        run
+    }
 }
 
 /// `render::render` itself, frame by frame (allocations, RGB8 output and
