@@ -318,6 +318,17 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
         let eye = eye.map(|e| mesh.bounds.map_or(e, |b| e.within(&b)));
         let detail = Detail::for_frame(mvp, &self.stage().config);
         let list = set.vertices;
+        if !list.is_empty() && detail.is_none() {
+            let parts = self.parts();
+            // Room for every piece the mesh could make: no dry run, so the
+            // tree is walked once (see `submit_clusters_in_one_walk`).
+            if parts.sink.room() >= mesh.indices.len().saturating_mul(MAX_PIECES) {
+                submit_clusters_in_one_walk::<S, N, _, _>(
+                    parts, mesh, mvp, set, eye, cull, first_id, cache,
+                );
+                return Ok(());
+            }
+        }
         let drawn = |f: &mut dyn FnMut(&Cluster)| {
             traverse(set, eye.as_ref(), detail.as_ref(), cull, |v| {
                 if let Visit::Draw(a, b) = v {
@@ -1035,14 +1046,7 @@ impl<A> ClusterJob<'_, A> {
     /// would borrow the same state.
     fn visit_in_order(&self, mut h: impl FnMut(Step)) {
         let clusters = self.set.clusters;
-        let count = |a: usize, b: usize| -> u64 {
-            clusters
-                .get(a..b)
-                .unwrap_or(&[])
-                .iter()
-                .map(|k| u64::from(k.triangles[1].saturating_sub(k.triangles[0])))
-                .sum()
-        };
+        let count = |a: usize, b: usize| triangles_of(clusters, a, b);
         let (eye, detail) = (self.eye.as_ref(), self.detail.as_ref());
         traverse(self.set, eye, detail, self.cull, |v| match v {
             Visit::Draw(a, b) => {
@@ -1139,20 +1143,112 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
                 .inner
                 .run_range::<S, N, K>(stage, stats, sink, tris, verts),
             Step::Skip(tris, why) => {
-                skipped.submitted += tris;
-                match why {
-                    Skipped::Leaf => skipped.culled_cluster += tris,
-                    Skipped::Inner => skipped.culled_hierarchy += tris,
-                    Skipped::Detail(node) => {
-                        skipped.culled_detail += tris;
-                        if let Some((quad, fill, id)) = self.detail_box::<N>(node) {
-                            draw_box::<S, N, K>(stage, quad, fill, id, stats, sink);
-                        }
+                count_skipped(&mut skipped, tris, why);
+                if let Skipped::Detail(node) = why {
+                    if let Some((quad, fill, id)) = self.detail_box::<N>(node) {
+                        draw_box::<S, N, K>(stage, quad, fill, id, stats, sink);
                     }
                 }
             }
         });
         *stats += skipped;
+    }
+}
+
+/// [`Submit::submit_clusters`] with a vertex list, no detail culling and
+/// room for every piece the mesh could make (so nothing needs counting
+/// first): one walk of the tree, where the general path walks it twice
+/// (once to mark the drawn clusters' vertices, once to draw them), and
+/// each walk tests every node it reaches, the size guard included.
+///
+/// Every entry of `cache` is first marked stale (non-finite); then each
+/// drawn cluster's listed vertices still stale are processed, and its
+/// triangles run at once. A triangle reads only entries processed this
+/// frame: those of its cluster's list (shared ones processed once, by the
+/// first cluster drawn that lists them), or, where the list misses a
+/// vertex, a stale entry, counted as non-finite (the general path may
+/// then read an entry of an earlier frame: bad data either way). A
+/// non-finite vertex stays marked and is processed again, to the same
+/// entry, by every cluster that lists it. For data that passed
+/// validation the frame and the counts are those of the general path.
+#[allow(clippy::too_many_arguments)]
+fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized, A>(
+    parts: Parts<'_, K>,
+    mesh: &Mesh<'_, A>,
+    mvp: &Mat4,
+    set: &ClusterSet<'_>,
+    eye: Option<Eye>,
+    cull: ClusterCull,
+    first_id: u32,
+    cache: &mut [ProcessedVertex],
+) where
+    A: Attributes<N>,
+{
+    let Parts { stage, stats, sink } = parts;
+    let c = &stage.config;
+    for v in cache.iter_mut() {
+        v.code = NONFINITE;
+    }
+    let (clusters, list) = (set.clusters, set.vertices);
+    let (mut drawn, mut skipped) = (Stats::default(), Stats::default());
+    traverse(set, eye.as_ref(), None, cull, |v| match v {
+        Visit::Draw(a, b) => {
+            for k in clusters.get(a..b).unwrap_or(&[]) {
+                let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+                for &id in ids.unwrap_or(&[]) {
+                    let id = id as usize;
+                    let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id)) else {
+                        continue;
+                    };
+                    if out.code & NONFINITE != 0 {
+                        process_vertices::<S>(
+                            c.width,
+                            c.height,
+                            stage.guard,
+                            mvp,
+                            core::slice::from_ref(p),
+                            core::slice::from_mut(out),
+                        );
+                    }
+                }
+                let job = ProcessedJob {
+                    mesh,
+                    first_id,
+                    cache: &*cache,
+                };
+                let [t0, t1] = k.triangles.map(|v| v as usize);
+                job.run_range::<S, N, K>(stage, &mut drawn, sink, t0..t1, 0..cache.len());
+            }
+        }
+        Visit::Cull(a, b, inner) => {
+            let why = if inner { Skipped::Inner } else { Skipped::Leaf };
+            count_skipped(&mut skipped, triangles_of(clusters, a, b), why);
+        }
+        // No detail culling here.
+        Visit::Detail(..) => {}
+    });
+    *stats += drawn;
+    *stats += skipped;
+}
+
+/// The triangles of clusters `a..b`.
+fn triangles_of(clusters: &[Cluster], a: usize, b: usize) -> u64 {
+    clusters
+        .get(a..b)
+        .unwrap_or(&[])
+        .iter()
+        .map(|k| u64::from(k.triangles[1].saturating_sub(k.triangles[0])))
+        .sum()
+}
+
+/// Counts `tris` triangles skipped for `why` (a detail box is drawn by
+/// the caller).
+fn count_skipped(skipped: &mut Stats, tris: u64, why: Skipped) {
+    skipped.submitted += tris;
+    match why {
+        Skipped::Leaf => skipped.culled_cluster += tris,
+        Skipped::Inner => skipped.culled_hierarchy += tris,
+        Skipped::Detail(_) => skipped.culled_detail += tris,
     }
 }
 
