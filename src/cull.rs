@@ -855,6 +855,9 @@ impl Projection {
     }
 
     /// [`Projection::reach`] with `c1` ([`ball_c1`]) found by the caller.
+    /// Inlined, so that the size guard ([`Screen::winding_floor`]), which
+    /// has no use for `axis`, does not divide for it.
+    #[inline(always)]
     fn reach_c1(&self, origin: [f32; 3], radius: f32, c1: f32) -> Option<Reach> {
         // A form's range over the ball: centre value +- spread.
         let [rx, ry, rw] = &self.rows;
