@@ -665,19 +665,10 @@ mod tests {
         // matrix whichever way the frames are ordered.
         let mut images = Vec::new();
         for extra in [&[][..], &["--sequential"], &["--threads", "1"]] {
-            let mut a = vec![
-                "--scene",
-                "cubes",
-                "--size",
-                "96x72",
-                "--frames",
-                "3",
-                "--warmup",
-                "1",
-                "--spin",
-                "7",
-                "--no-split",
-            ];
+            let mut a: Vec<&str> =
+                "--scene cubes --size 96x72 --frames 3 --warmup 1 --spin 7 --no-split"
+                    .split(' ')
+                    .collect();
             if !extra.contains(&"--threads") {
                 a.extend_from_slice(&["--threads", "1,2,3"]);
             }
