@@ -113,17 +113,25 @@ pub fn bench_with<const S: u32, C: BenchColor, T: DepthWord>(
     depth_on: bool,
     progress: &mut Progress,
 ) -> Result<Formats, String> {
-    let mut runs = Vec::new();
     let n = s.threads.len();
-    if s.interleave && n > 1 {
-        runs = run_interleaved::<S, C, T>(bs, s, depth_on, progress)?;
+    let mut runs = if s.interleave && n > 1 {
+        run_interleaved::<S, C, T>(bs, s, depth_on, progress)?
     } else {
+        let mut runs = Vec::new();
         for (i, &threads) in s.threads.iter().enumerate() {
             let what = format!("run {}/{n} ({threads} threads)", i + 1);
-            let run = run_frames::<S, C, T>(bs, s, depth_on, threads, i == 0, &what, progress)?;
-            runs.push(run);
+            runs.push(run_frames::<S, C, T>(
+                bs,
+                s,
+                depth_on,
+                threads,
+                i == 0,
+                &what,
+                progress,
+            )?);
         }
-    }
+        runs
+    };
     let image = runs.first_mut().and_then(|r| r.image.take());
     let render_fn = if s.render_fn {
         Some(render_fn_section(bs, s, runs[0].threads, progress)?)
