@@ -29,7 +29,8 @@
 //! over several threads, runs that stage and the drawing in one thread
 //! scope (`render_fused`): each worker sets up and bins its chunk,
 //! publishes its frame, waits at a gate for the others', then draws strips
-//! of every frame; a frame starts one thread fewer, and drawing begins as
+//! of every frame, in runs of about equal cost estimated from the bins
+//! (`Runs::weigh`); a frame starts one thread fewer, and drawing begins as
 //! the last frame is binned.
 //! Every strip draws the frames in order and the core draws triangles in
 //! submission order, so the image is byte-identical for any thread count and
@@ -681,15 +682,26 @@ fn drain<W, S>(
 }
 
 /// Work items dealt out as one contiguous run per worker: a worker takes
-/// the items of its own run from the front and, once that is empty, the
-/// last item of the longest run left. Neighbouring items (strips that share
-/// triangles) thus mostly go to one worker, whose caches hold what they
-/// share, while the work still balances: taking strips from one shared
-/// queue in order made each worker's strips about 7 % slower than on one
-/// thread (the bunny at 1920x1080, 2026-12-06).
+/// the items of its own run from one end and, once that is empty, an item
+/// from the other end of the run with the most work left. Neighbouring
+/// items (strips that share triangles) thus mostly go to one worker, whose
+/// caches hold what they share, while the work still balances: taking
+/// strips from one shared queue in order made each worker's strips about
+/// 7 % slower than on one thread (the bunny at 1920x1080, 2026-12-06).
+/// Unweighed, the runs are of equal length, each taken front to back by
+/// its worker and back to front by the others. [`Runs::weigh`] gives each
+/// item an estimated cost: the runs are then of about equal cost, and each
+/// worker starts at its run's heavier end, so that the last items, which
+/// decide when the last worker ends, are the light ones (the bunny's
+/// strips: 10 us where the bunny is not, up to 200 us where it is).
 struct Runs<W> {
     items: Vec<Option<W>>,
     runs: Vec<Range<usize>>,
+    /// Each item's estimated cost (1 each until weighed).
+    cost: Vec<u64>,
+    /// Whether each run's own worker takes it back to front.
+    down: Vec<bool>,
+    weighed: bool,
 }
 
 impl<W> Runs<W> {
@@ -699,24 +711,63 @@ impl<W> Runs<W> {
         Runs {
             items: work.into_iter().map(Some).collect(),
             runs: (0..k).map(|w| w * n / k..(w + 1) * n / k).collect(),
+            cost: vec![1; n],
+            down: vec![false; k],
+            weighed: false,
+        }
+    }
+
+    /// Splits the work anew into runs of about equal cost, `cost(i, item)`
+    /// each item's, each run's worker to start at its heavier half's end;
+    /// once, and only before any item is taken (else nothing changes).
+    fn weigh(&mut self, cost: impl Fn(usize, &W) -> u64) {
+        let untouched = self.items.iter().all(Option::is_some);
+        if self.weighed || !untouched {
+            return;
+        }
+        self.weighed = true;
+        self.cost = (self.items.iter().enumerate())
+            .map(|(i, w)| w.as_ref().map_or(0, |w| cost(i, w)))
+            .collect();
+        let (n, k) = (self.items.len(), self.runs.len() as u64);
+        let total: u64 = self.cost.iter().sum();
+        // Run w ends at the first item where the running cost reaches
+        // (w + 1) / k of the total.
+        let (mut start, mut sum, mut i) = (0, 0u64, 0);
+        for w in 0..k {
+            let goal = (w + 1) * total / k;
+            while i < n && (sum < goal || w + 1 == k) {
+                sum += self.cost[i];
+                i += 1;
+            }
+            self.runs[w as usize] = start..i;
+            start = i;
+        }
+        for (r, down) in self.runs.iter().zip(&mut self.down) {
+            let mid = r.start + r.len() / 2;
+            let half = |h: Range<usize>| self.cost[h].iter().sum::<u64>();
+            *down = half(mid..r.end) > half(r.start..mid);
         }
     }
 
     /// Worker `w`'s next item and its index in the work, if any is left.
     fn take(&mut self, w: usize) -> Option<(usize, W)> {
         let own = self.runs.get(w).filter(|r| !r.is_empty()).map(|_| w);
+        let left = |r: &Range<usize>| self.cost[r.clone()].iter().sum::<u64>();
         let v = own.or_else(|| {
             (0..self.runs.len())
                 .filter(|&v| !self.runs[v].is_empty())
-                .max_by_key(|&v| self.runs[v].len())
+                .max_by_key(|&v| left(&self.runs[v]))
         })?;
+        // The owner from its end, the others from the other.
+        let from_back = (v == w) == self.down[v];
         let r = &mut self.runs[v];
-        let i = if v == w {
-            r.start += 1;
-            r.start - 1
-        } else {
+        let i = if from_back {
             r.end -= 1;
             r.end
+        } else {
+            r.start += 1;
+            r.start - 1
         };
         Some((i, self.items[i].take()?))
     }
@@ -1335,9 +1386,9 @@ impl<const S: u32> FramePipeline<S> {
     /// strips, in one thread scope: each worker sets up and bins its chunk
     /// of the scene (a worker beyond the chunks, none), publishes its
     /// frame, waits at a [`Gate`] for the others' and then draws strips of
-    /// every frame, as `Runs` deals them (the strips and pixels of
-    /// [`draw_layers`]). A frame of two threads
-    /// thus starts one thread fewer, and its drawing begins when the last
+    /// every frame, as `Runs` deals them once weighed by the bins (the
+    /// strips and pixels of [`draw_layers`]). A frame of two threads thus
+    /// starts one thread fewer, and its drawing begins when the last
     /// frame is binned, not after that worker's thread has ended and
     /// another has started (some 80 us on this 2-core machine). A worker
     /// that panics or fails still passes the gate; then no strip is drawn
@@ -1399,6 +1450,13 @@ impl<const S: u32> FramePipeline<S> {
                 let Some(layers) = layers else {
                     return Ok(0);
                 };
+                // The first worker here weighs the strips by their bins.
+                lock(&queue).weigh(|i, (_, c, _): &Work<'_, C, T>| {
+                    let items: usize = (layers.iter())
+                        .map(|(_, b)| b.strip_items(i as u32).len())
+                        .sum();
+                    strip_cost(items, c.len())
+                });
                 let draw = |(y0, c, d): Work<'_, C, T>, _: &mut ()| {
                     let y1 = y0 + (c.len() / width.max(1)) as u32;
                     let rect = [0, config.width, y0, y1];
@@ -1449,6 +1507,18 @@ impl<const S: u32> FramePipeline<S> {
         }
     }
 }
+
+/// A strip's estimated drawing cost from the triangles binned to it and
+/// its pixels, in units of one binned triangle: clearing [`CLEAR_PIXELS`]
+/// pixels costs about as much as drawing a triangle of the bunny at
+/// 1920x1080 (strips of 16 rows: 10 us empty, 10 us + 0.13 us a triangle,
+/// 2026-12-07).
+fn strip_cost(triangles: usize, pixels: usize) -> u64 {
+    (triangles + pixels / CLEAR_PIXELS) as u64
+}
+
+/// Pixels cleared at the cost of one binned triangle drawn ([`strip_cost`]).
+const CLEAR_PIXELS: usize = 400;
 
 /// One worker of [`FramePipeline::render_fused`]: its index and, if it
 /// sets up a chunk, its storage and bins and its chunk of the scene.
@@ -1651,6 +1721,90 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Weighed [`Runs`] split the work into runs of about equal cost, in
+    /// order; each worker starts at its run's heavier half's end, the
+    /// others take from the other end of the run with the most cost left;
+    /// every item is dealt once. Weighing after a take changes nothing.
+    #[test]
+    fn weighed_runs_balance_cost_and_end_light() {
+        let mut seed = 0x2545_f491_u32;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed
+        };
+        for n in 0..40usize {
+            for workers in 1..5usize {
+                let cost: Vec<u64> = (0..n).map(|_| u64::from(next() % 50)).collect();
+                let mut runs = Runs::new((0..n).collect::<Vec<usize>>(), workers);
+                runs.weigh(|i, &item| {
+                    assert_eq!(i, item);
+                    cost[i]
+                });
+                let total: u64 = cost.iter().sum();
+                let most = cost.iter().copied().max().unwrap_or(0);
+                let mut end = 0;
+                for r in &runs.runs {
+                    assert_eq!(r.start, end, "runs in order");
+                    end = r.end;
+                    let c: u64 = cost[r.clone()].iter().sum();
+                    assert!(
+                        c <= total / workers as u64 + most,
+                        "run {r:?} costs {c} of {total}"
+                    );
+                }
+                assert_eq!(end, n);
+                let own: Vec<Range<usize>> = runs.runs.clone();
+                let mut seen = vec![false; n];
+                let mut first = vec![true; workers];
+                for _ in 0..n {
+                    let w = next() as usize % workers;
+                    let before = runs.runs.clone();
+                    let left = |r: &Range<usize>| cost[r.clone()].iter().sum::<u64>();
+                    let (i, item) = runs.take(w).expect("items are left");
+                    assert_eq!(i, item);
+                    assert!(!seen[i], "item {i} dealt twice");
+                    seen[i] = true;
+                    let v = (0..workers).find(|&v| own[v].contains(&i)).unwrap();
+                    let down = runs.down[v];
+                    if !before[w].is_empty() {
+                        assert_eq!(v, w, "own run first");
+                        let r = &own[w];
+                        let mid = r.start + r.len() / 2;
+                        let heavier_back = left(&(mid..r.end)) > left(&(r.start..mid));
+                        assert_eq!(down, heavier_back);
+                        if first[w] {
+                            assert_eq!(i, if down { r.end - 1 } else { r.start });
+                            first[w] = false;
+                        }
+                    } else {
+                        let most_left = before.iter().map(left).max().unwrap();
+                        assert_eq!(left(&before[v]), most_left, "the run with the most left");
+                        let far = if down {
+                            before[v].start
+                        } else {
+                            before[v].end - 1
+                        };
+                        assert_eq!(i, far, "from its other end");
+                    }
+                }
+                assert!(seen.iter().all(|&s| s));
+                for w in 0..workers {
+                    assert!(runs.take(w).is_none());
+                }
+            }
+        }
+        let mut runs = Runs::new(vec![0, 1, 2, 3], 2);
+        assert_eq!(runs.take(0).map(|t| t.0), Some(0));
+        runs.weigh(|i, _| [0, 0, 0, 9][i]);
+        assert_eq!(
+            runs.runs,
+            [1..2, 2..4],
+            "weighing after a take changes nothing"
+        );
     }
 
     /// [`each_on_threads`] gives the results in order, a panicked
