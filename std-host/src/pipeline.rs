@@ -763,7 +763,11 @@ impl<W> Runs<W> {
     /// Worker `w`'s next item and its index in the work, if any is left.
     fn take(&mut self, w: usize) -> Option<(usize, W)> {
         let own = self.runs.get(w).filter(|r| !r.is_empty()).map(|_| w);
-        let left = |r: &Range<usize>| self.cost[r.clone()].iter().sum::<u64>();
+        // (Unweighed, every item costs 1: no sum over the run.)
+        let left = |r: &Range<usize>| match self.weighed {
+            true => self.cost[r.clone()].iter().sum::<u64>(),
+            false => r.len() as u64,
+        };
         let v = own.or_else(|| {
             (0..self.runs.len())
                 .filter(|&v| !self.runs[v].is_empty())
