@@ -698,7 +698,7 @@ fn drain<W, S>(
 struct Runs<W> {
     items: Vec<Option<W>>,
     runs: Vec<Range<usize>>,
-    /// Each item's estimated cost (1 each until weighed).
+    /// Each item's estimated cost (empty until weighed: every item 1).
     cost: Vec<u64>,
     /// Whether each run's own worker takes it back to front.
     down: Vec<bool>,
@@ -712,7 +712,7 @@ impl<W> Runs<W> {
         Runs {
             items: work.into_iter().map(Some).collect(),
             runs: (0..k).map(|w| w * n / k..(w + 1) * n / k).collect(),
-            cost: vec![1; n],
+            cost: Vec::new(),
             down: vec![false; k],
             weighed: false,
         }
@@ -743,15 +743,17 @@ impl<W> Runs<W> {
         let fine = heaviest.saturating_mul(4 * k) <= total;
         // Run w ends where the running cost comes nearest (w + 1) / k of
         // the total: an item joins it if at least half of it fits.
-        let (mut start, mut sum, mut i) = (0, 0u64, 0);
-        for w in (0..k).filter(|_| fine) {
-            let goal = (w + 1) * total / k;
-            while i < n && (sum + self.cost[i] / 2 < goal || w + 1 == k) {
-                sum += self.cost[i];
-                i += 1;
+        if fine {
+            let (mut start, mut sum, mut i) = (0, 0u64, 0);
+            for w in 0..k {
+                let goal = (w + 1) * total / k;
+                while i < n && (sum + self.cost[i] / 2 < goal || w + 1 == k) {
+                    sum += self.cost[i];
+                    i += 1;
+                }
+                self.runs[w as usize] = start..i;
+                start = i;
             }
-            self.runs[w as usize] = start..i;
-            start = i;
         }
         for (r, down) in self.runs.iter().zip(&mut self.down) {
             let mid = r.start + r.len() / 2;
