@@ -86,9 +86,22 @@ pub fn guard_band_ndc<const S: u32>(width: u32, height: u32) -> (f32, f32) {
 /// a tie that `f32` rounds to even.)
 #[inline]
 fn round_to_coord(v: f32) -> Option<i32> {
-    if !(v.is_finite() && v.abs() <= COORD_LIMIT as f32) {
+    if !in_coord_range(v) {
         return None;
     }
+    Some(round_in_range(v))
+}
+
+/// `v` is finite and within `±COORD_LIMIT` (NaN is not).
+#[inline(always)]
+pub(crate) fn in_coord_range(v: f32) -> bool {
+    v.is_finite() && v.abs() <= COORD_LIMIT as f32
+}
+
+/// [`round_to_coord`] of a `v` that [`in_coord_range`] accepted; for any
+/// other `v` some `i32`, never a panic.
+#[inline(always)]
+pub(crate) fn round_in_range(v: f32) -> i32 {
     // |v| <= 2^28: `as` truncates exactly, `i as f32` is exact (below 2^24
     // every integer is representable; above it `v` is an integer), and so
     // is the fraction `f = v - i`, in (-1, 1). Halves go up.
@@ -96,7 +109,7 @@ fn round_to_coord(v: f32) -> Option<i32> {
     let f = v - i as f32;
     let up = (f >= 0.5) as i32;
     let down = (f < -0.5) as i32;
-    Some(i + up - down)
+    i + up - down
 }
 
 /// `x as i64` (truncation toward zero, saturating, NaN gives 0) without the
@@ -223,6 +236,29 @@ fn snap_f64<const S: u32>(
     })
 }
 
+/// The window position of clip-space `(x, y, z)` with `inv_w = 1 / w`,
+/// before rounding: `Sub<S>` x and y as `f32`, depth in `[0, 1]` for a
+/// point inside the near and far planes. The one formula of [`snap_inv`]
+/// and of the vertex stage's batches.
+#[inline(always)]
+pub(crate) fn window_inv<const S: u32>(
+    x: f32,
+    y: f32,
+    z: f32,
+    inv_w: f32,
+    width: u32,
+    height: u32,
+) -> (f32, f32, f32) {
+    const { check_subpixel_bits::<S>() };
+    let half_w = width as f32 * 0.5;
+    let half_h = height as f32 * 0.5;
+    let scale = (1u32 << S) as f32;
+    let wx = (x * inv_w * half_w + half_w) * scale;
+    let wy = (half_h - y * inv_w * half_h) * scale;
+    let zw = z * inv_w * 0.5 + 0.5;
+    (wx, wy, zw)
+}
+
 /// [`snap`] with `1 / w` already computed (and `w > 0` already checked).
 #[inline]
 pub(crate) fn snap_inv<const S: u32>(
@@ -233,13 +269,7 @@ pub(crate) fn snap_inv<const S: u32>(
     width: u32,
     height: u32,
 ) -> Option<SnappedVertex> {
-    const { check_subpixel_bits::<S>() };
-    let half_w = width as f32 * 0.5;
-    let half_h = height as f32 * 0.5;
-    let scale = (1u32 << S) as f32;
-    let wx = (x * inv_w * half_w + half_w) * scale;
-    let wy = (half_h - y * inv_w * half_h) * scale;
-    let zw = z * inv_w * 0.5 + 0.5;
+    let (wx, wy, zw) = window_inv::<S>(x, y, z, inv_w, width, height);
     if !zw.is_finite() {
         return None;
     }

@@ -482,6 +482,7 @@ impl Mat4 {
     }
 
     /// `self * v`.
+    #[cfg_attr(target_pointer_width = "64", inline)]
     pub fn mul_vec4(&self, v: Vec4) -> Vec4 {
         let c = &self.cols;
         Vec4::new(
@@ -493,6 +494,9 @@ impl Mat4 {
     }
 
     /// `self * (p, 1)`: a point to clip space.
+    // (Inlined on 64-bit hosts, into the vertex stage's batches; 32-bit
+    // cores keep the call, which their instruction counts of record use.)
+    #[cfg_attr(target_pointer_width = "64", inline)]
     pub fn transform_point(&self, p: Vec3) -> Vec4 {
         self.mul_vec4(p.extend(1.0))
     }
