@@ -212,7 +212,8 @@ pub(crate) struct Geometry {
 }
 
 /// Area, culling, winding and bounding box of a snapped triangle.
-#[inline]
+#[cfg_attr(target_pointer_width = "64", inline(always))]
+#[cfg_attr(not(target_pointer_width = "64"), inline)]
 pub(crate) fn setup_geometry<const S: u32>(
     s: &[SnappedVertex; 3],
     width: u32,
@@ -280,7 +281,8 @@ pub(crate) fn setup_geometry<const S: u32>(
 impl Geometry {
     /// Completes setup with the vertices' `1 / w` (all positive) and
     /// varyings, in input order (the winding swap is applied here).
-    #[inline]
+    #[cfg_attr(target_pointer_width = "64", inline(always))]
+    #[cfg_attr(not(target_pointer_width = "64"), inline)]
     pub(crate) fn finish<const N: usize>(
         self,
         inv_w: [f32; 3],
