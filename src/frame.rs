@@ -150,7 +150,8 @@ impl<const N: usize> Sink<N> for Store<'_, N> {
     fn capacity(&self) -> usize {
         self.storage.len()
     }
-    #[inline]
+    #[cfg_attr(target_pointer_width = "64", inline(always))]
+    #[cfg_attr(not(target_pointer_width = "64"), inline)]
     fn take(&mut self, t: &SetupTriangle<N>) {
         if let Some(slot) = self.storage.get_mut(self.len) {
             *slot = *t;
