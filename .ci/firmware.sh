@@ -515,13 +515,19 @@ done
 # strip drawing them front to back plainly (`herd`) or through an
 # `Occluder` (`herd-occlusion`); both frames must be the herd's host
 # frame (host-checksums.txt `spot-flat-herd`), counts of record in
-# docs/embedded.md, and the occlusion build must hide something.
+# docs/embedded.md, and the occlusion build must hide something, and
+# print its sweep of 8 cameras (each frame drawn with the test and
+# without; the firmware fails if any pair differs).
 herd_rows=()
 for v in "${herd_variants[@]}"; do
   spot_run thumbv7em-none-eabihf mps2-an386 "$v" spot-flat-herd herd_rows || continue
   case $v in *herd-occlusion)
     if ! grep -qE '^herd of [0-9]+ Spots: hidden by occlusion before transform [1-9]' "$out"; then
       echo "FAIL: mps2-an386 $v hid no triangle"
+      failed=1
+    fi
+    if ! grep -E '^herd sweep of 8 cameras: hidden by occlusion before transform [1-9]' "$out"; then
+      echo "FAIL: mps2-an386 $v printed no herd sweep that hid anything"
       failed=1
     fi
     ;;

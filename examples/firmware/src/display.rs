@@ -38,7 +38,11 @@ pub enum DisplayError {
 }
 
 /// A frame in progress, set aside ([`HashDisplay::save`]).
-#[cfg(any(feature = "clusters", feature = "house-portals"))]
+#[cfg(any(
+    feature = "clusters",
+    feature = "house-portals",
+    feature = "herd-occlusion"
+))]
 #[derive(Clone, Copy, Default)]
 pub struct Saved {
     next_row: u32,
@@ -75,7 +79,11 @@ impl HashDisplay {
 
     /// The frame received so far (checksum state, rows, pushes, ticks),
     /// to set aside while other frames go through the same display.
-    #[cfg(any(feature = "clusters", feature = "house-portals"))]
+    #[cfg(any(
+        feature = "clusters",
+        feature = "house-portals",
+        feature = "herd-occlusion"
+    ))]
     pub fn save(&self) -> Saved {
         Saved {
             next_row: self.next_row,
@@ -86,7 +94,11 @@ impl HashDisplay {
     }
 
     /// Puts a saved frame back (a new frame: `Saved::default()`).
-    #[cfg(any(feature = "clusters", feature = "house-portals"))]
+    #[cfg(any(
+        feature = "clusters",
+        feature = "house-portals",
+        feature = "herd-occlusion"
+    ))]
     pub fn restore(&mut self, s: Saved) {
         (self.next_row, self.sum, self.pushes, self.ticks) = (s.next_row, s.sum, s.pushes, s.ticks);
     }

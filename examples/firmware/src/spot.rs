@@ -20,7 +20,7 @@
 //! and rasterization (with shading) the rest of the render.
 
 use crate::clock::Clock;
-#[cfg(feature = "clusters")]
+#[cfg(any(feature = "clusters", feature = "herd-occlusion"))]
 use crate::display::Saved;
 use crate::display::{push, HashDisplay};
 #[cfg(any(feature = "clusters", feature = "herd", feature = "cull-masks"))]
@@ -179,7 +179,16 @@ type Drawn = [u32; clustered::CLUSTER_COUNT.div_ceil(32)];
 /// With `cull-masks-frame`: the frame's normal mask, for every strip.
 #[cfg(feature = "cull-masks-frame")]
 type Drawn = microraster::BackMask;
-#[cfg(not(any(feature = "clusters", feature = "cull-masks-frame")))]
+/// With `herd`: the herd's order front to back, and (in the
+/// `herd-occlusion` builds, whose sweep draws each frame both ways)
+/// whether the occlusion test is on.
+#[cfg(feature = "herd")]
+#[derive(Clone, Copy)]
+struct Drawn {
+    order: [u8; spot_scene::HERD_SPOTS],
+    occlude: bool,
+}
+#[cfg(not(any(feature = "clusters", feature = "cull-masks-frame", feature = "herd")))]
 type Drawn = ();
 
 /// Walks the cluster tree once with `eye` (none: every cluster drawn).
@@ -205,7 +214,15 @@ fn decide(mvp: &Mat4, config: &Config) -> Drawn {
     return drawn_clusters(cluster_eye(mvp, config).as_ref());
     #[cfg(feature = "cull-masks-frame")]
     return microraster::BackMask::for_frame::<8>(mvp, config, None, &normal_classes());
-    #[cfg(not(any(feature = "clusters", feature = "cull-masks-frame")))]
+    #[cfg(feature = "herd")]
+    {
+        let _ = (mvp, config);
+        Drawn {
+            order: spot_scene::herd_order(spot_scene::HERD_EYE),
+            occlude: cfg!(feature = "herd-occlusion"),
+        }
+    }
+    #[cfg(not(any(feature = "clusters", feature = "cull-masks-frame", feature = "herd")))]
     let _ = (mvp, config);
 }
 
@@ -495,6 +512,94 @@ impl Draw for SweepFrames<'_> {
     }
 }
 
+/// The `herd-occlusion` builds' camera sweep ([`spot_scene::HERD_SWEEP`]
+/// cameras round the herd at eye height), drawn through the firmware's
+/// strip loop after the frame of record, as the cluster builds' sweep is:
+/// each frame with the occlusion test and without, and compared.
+#[cfg(feature = "herd-occlusion")]
+struct HerdSweepFrames<'a> {
+    config: Config,
+    color: &'a mut [Rgb565],
+    depth: &'a mut [u16],
+    display: &'a mut HashDisplay,
+}
+
+#[cfg(feature = "herd-occlusion")]
+impl Draw for HerdSweepFrames<'_> {
+    type Out = HerdSweep;
+
+    fn draw<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N> + Copy>(
+        self,
+        mesh: &Mesh<'_, A>,
+        fragment: F,
+    ) -> HerdSweep {
+        let HerdSweepFrames {
+            config,
+            color,
+            depth,
+            display,
+        } = self;
+        let saved = display.save();
+        let mut s = HerdSweep {
+            hidden: 0,
+            submitted: 0,
+            min_hidden: u64::MAX,
+            max_hidden: 0,
+            occluded: 0,
+            plain: 0,
+            identical: true,
+        };
+        for j in 0..spot_scene::HERD_SWEEP {
+            let eye = spot_scene::herd_sweep_eye(j);
+            let vp = spot_scene::herd_view(WIDTH, HEIGHT, eye);
+            let order = spot_scene::herd_order(eye);
+            // Occluded, then the same frame plain. Pushes excluded.
+            let mut sums = [None; 2];
+            let mut ticks = [0; 2];
+            for (i, occlude) in [true, false].into_iter().enumerate() {
+                display.restore(Saved::default());
+                let t = display.clock.now();
+                let drawn = Drawn { order, occlude };
+                let f = frame(config, &vp, &drawn, color, depth, display, mesh, fragment);
+                ticks[i] = display.clock.now() - t - display.ticks;
+                sums[i] = display.checksum().filter(|_| f.is_ok());
+                if let (true, Ok((_, (hidden, submitted, _)))) = (occlude, f) {
+                    // Per mille of the camera's submissions, for its range.
+                    let share = hidden * 1000 / submitted.max(1);
+                    s.hidden += hidden;
+                    s.submitted += submitted;
+                    s.min_hidden = s.min_hidden.min(share);
+                    s.max_hidden = s.max_hidden.max(share);
+                }
+            }
+            s.identical &= sums[0].is_some() && sums[0] == sums[1];
+            s.occluded += ticks[0];
+            s.plain += ticks[1];
+        }
+        display.restore(saved);
+        s
+    }
+}
+
+/// What the herd sweep measured.
+#[cfg(feature = "herd-occlusion")]
+struct HerdSweep {
+    /// Triangles hidden before transform and submitted to the strips,
+    /// summed over the cameras (the strips' counts, as the frame of
+    /// record's), and the fewest and most hidden at one camera, per mille
+    /// of its submissions.
+    hidden: u64,
+    submitted: u64,
+    min_hidden: u64,
+    max_hidden: u64,
+    /// Ticks of the frames with the test (pushes excluded), and of the
+    /// same frames without it.
+    occluded: u64,
+    plain: u64,
+    /// Whether every occluded frame's checksum equals its plain one's.
+    identical: bool,
+}
+
 /// The cluster builds' camera sweep ([`spot_scene::SWEEP`] cameras round
 /// Spot), each frame drawn culled and with every cluster, and compared.
 #[cfg(feature = "clusters")]
@@ -622,9 +727,10 @@ fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
     strip: &mut StripRenderer<'_, Rgb565, [u16], 8, N, F>,
     mesh: &Mesh<'_, A>,
     vp: &Mat4,
-    _drawn: &Drawn,
+    drawn: &Drawn,
 ) -> Result<(), &'static str> {
     let n = mesh.indices.len();
+    let model = |k: usize| spot_scene::herd_cell_model(drawn.order[k] as usize);
     let run = |k: usize, j: usize, indices, sphere: &microraster::BoundingSphere| {
         let run = Mesh {
             indices,
@@ -634,14 +740,16 @@ fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
         (run, (k * n + j * spot_scene::CHUNK_TRIANGLES) as u32)
     };
     let bounds = chunks::CHUNKS.iter().zip(chunks::BOXES.iter());
-    #[cfg(not(feature = "herd-occlusion"))]
-    for k in 0..spot_scene::HERD_SPOTS {
-        let mvp = *vp * spot_scene::herd_model(k);
-        let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
-        for (j, (indices, (sphere, _))) in runs.zip(bounds.clone()).enumerate() {
-            let (run, first) = run(k, j, indices, sphere);
-            strip.submit_mesh(&run, &mvp, first).map_err(|_| "submit")?;
+    if !(cfg!(feature = "herd-occlusion") && drawn.occlude) {
+        for k in 0..spot_scene::HERD_SPOTS {
+            let mvp = *vp * model(k);
+            let runs = mesh.indices.chunks(spot_scene::CHUNK_TRIANGLES);
+            for (j, (indices, (sphere, _))) in runs.zip(bounds.clone()).enumerate() {
+                let (run, first) = run(k, j, indices, sphere);
+                strip.submit_mesh(&run, &mvp, first).map_err(|_| "submit")?;
+            }
         }
+        return Ok(());
     }
     #[cfg(feature = "herd-occlusion")]
     {
@@ -649,7 +757,7 @@ fn submit_chunks<const N: usize, A: Attributes<N> + Copy, F: FragmentShader<N>>(
         let mut tiles = [HiZTile::default(); tiles_for(WIDTH, STRIP_ROWS as u32)];
         let mut o = strip.occluder(&mut tiles).map_err(|_| "occluder")?;
         for k in 0..spot_scene::HERD_SPOTS {
-            let mvp = *vp * spot_scene::herd_model(k);
+            let mvp = *vp * model(k);
             let whole = (&chunks::WHOLE_SPHERE, &chunks::WHOLE_BOX);
             if o.skips(Some(whole.0), Some(whole.1), &mvp, n as u64) {
                 continue;
@@ -820,6 +928,22 @@ fn main() -> ! {
             }
         }
     };
+    #[cfg(feature = "herd-occlusion")]
+    let herd_sweep = {
+        let frames = HerdSweepFrames {
+            config,
+            color: &mut COLOR[..],
+            depth: &mut DEPTH[..],
+            display: &mut display,
+        };
+        match spot_scene::draw(&model, frames) {
+            Ok(s) => s,
+            Err(e) => {
+                hprintln!("FAIL: herd sweep: {}", e);
+                exit(false)
+            }
+        }
+    };
     let written = match m.written {
         Ok(w) => w,
         Err(e) => {
@@ -951,6 +1075,32 @@ fn main() -> ! {
             b,
             m.reached
         );
+    }
+    #[cfg(feature = "herd-occlusion")]
+    {
+        let s = &herd_sweep;
+        let n = spot_scene::HERD_SWEEP as u64;
+        let (a, b) = ratio(s.hidden * 100, s.submitted);
+        let (occluded, plain) = (instr(s.occluded) / n, instr(s.plain) / n);
+        let q = (occluded * 1000 + plain / 2) / plain.max(1);
+        hprintln!(
+            "herd sweep of {} cameras: hidden by occlusion before transform {}.{} % of the triangles submitted to the strips ({}.{}-{}.{} %); render a frame {} with the test, {} without ({}.{:03}x)",
+            n,
+            a,
+            b,
+            s.min_hidden / 10,
+            s.min_hidden % 10,
+            s.max_hidden / 10,
+            s.max_hidden % 10,
+            occluded,
+            plain,
+            q / 1000,
+            q % 1000
+        );
+        if !s.identical {
+            hprintln!("FAIL: a herd sweep frame with the occlusion test differs from the same frame without it");
+            exit(false)
+        }
     }
     #[cfg(feature = "cull-masks")]
     {

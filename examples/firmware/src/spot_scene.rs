@@ -106,8 +106,7 @@ pub fn normal_color(n: Vec3) -> Rgb888 {
 /// host's `spots` scene; each Spot's [`herd_model`] goes on the right).
 pub fn mvp(width: u32, height: u32) -> Mat4 {
     #[cfg(feature = "herd")]
-    return Mat4::perspective(radians(60.0), width as f32 / height as f32, 0.5, 50.0)
-        * Mat4::look_at(HERD_EYE, HERD_TARGET, Vec3::new(0.0, 1.0, 0.0));
+    return herd_view(width, height, HERD_EYE);
     #[cfg(not(feature = "herd"))]
     return Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
         * Mat4::look_at(EYE, TARGET, Vec3::new(0.0, 1.0, 0.0));
@@ -156,15 +155,21 @@ const fn herd_cell(c: usize) -> (f32, f32, f32) {
 /// The herd's cells front to back as the camera sees them (by the
 /// distance from [`HERD_EYE`] to each cell's centre, ties by cell): the
 /// strips draw the nearest first, what occlusion culling needs to hide the
-/// rest. Sorted at compile time.
+/// rest. Sorted at compile time, for build.rs (the firmware sorts at run
+/// time with the same function, for its sweep's cameras too).
 #[allow(dead_code)]
-const HERD_ORDER: [u8; HERD_SPOTS] = {
+const HERD_ORDER: [u8; HERD_SPOTS] = herd_order(HERD_EYE);
+
+/// The herd's cells front to back from `eye` (by the distance from `eye`
+/// to each cell's centre on the ground, ties by cell).
+#[allow(dead_code)]
+pub const fn herd_order(eye: Vec3) -> [u8; HERD_SPOTS] {
     let mut d = [0.0f32; HERD_SPOTS];
     let mut order = [0u8; HERD_SPOTS];
     let mut c = 0;
     while c < HERD_SPOTS {
         let (x, z, _) = herd_cell(c);
-        let (dx, dz) = (x - HERD_EYE.x, z - HERD_EYE.z);
+        let (dx, dz) = (x - eye.x, z - eye.z);
         d[c] = dx * dx + dz * dz;
         order[c] = c as u8;
         c += 1;
@@ -182,15 +187,55 @@ const HERD_ORDER: [u8; HERD_SPOTS] = {
         a += 1;
     }
     order
-};
+}
 
 /// Object to world space of the herd's `k`-th Spot front to back: turned
 /// about the vertical axis, then moved to its cell (normals and lights
 /// stay in object space).
 #[allow(dead_code)]
 pub fn herd_model(k: usize) -> Mat4 {
-    let (x, z, yaw) = herd_cell(HERD_ORDER[k % HERD_SPOTS] as usize);
+    herd_cell_model(HERD_ORDER[k % HERD_SPOTS] as usize)
+}
+
+/// Object to world space of the Spot in grid cell `c` (row-major).
+#[allow(dead_code)]
+pub fn herd_cell_model(c: usize) -> Mat4 {
+    let (x, z, yaw) = herd_cell(c % HERD_SPOTS);
     Mat4::translation(Vec3::new(x, 0.0, z)) * Mat4::rotation_y(yaw)
+}
+
+/// Cameras of the `herd-occlusion` builds' sweep: [`HERD_EYE`] turned
+/// about the vertical axis through the herd's centre by 45 degrees at a
+/// time: the host's `spots_camera(8 j, 64, 10)` for `j` in `0..8` (to
+/// `f32` rounding), each looking at [`HERD_TARGET`].
+#[allow(dead_code)]
+pub const HERD_SWEEP: usize = 8;
+
+/// The eye of the herd sweep's camera `j` (see [`HERD_SWEEP`]).
+#[allow(dead_code)]
+pub fn herd_sweep_eye(j: usize) -> Vec3 {
+    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
+    const TURNS: [(f32, f32); HERD_SWEEP] = [
+        (1.0, 0.0),
+        (H, H),
+        (0.0, 1.0),
+        (-H, H),
+        (-1.0, 0.0),
+        (-H, -H),
+        (0.0, -1.0),
+        (H, -H),
+    ];
+    let (c, s) = TURNS[j % HERD_SWEEP];
+    let (x, z) = (HERD_EYE.x, HERD_EYE.z);
+    Vec3::new(x * c - z * s, HERD_EYE.y, x * s + z * c)
+}
+
+/// World to clip space for the herd seen from `eye` (60 degrees, as the
+/// host's `spots` scene), looking at [`HERD_TARGET`].
+#[allow(dead_code)]
+pub fn herd_view(width: u32, height: u32, eye: Vec3) -> Mat4 {
+    Mat4::perspective(radians(60.0), width as f32 / height as f32, 0.5, 50.0)
+        * Mat4::look_at(eye, HERD_TARGET, Vec3::new(0.0, 1.0, 0.0))
 }
 
 /// Cameras of the cluster builds' sweep: eyes on the circle through
