@@ -407,6 +407,7 @@ pub fn fill<const S: u32, K: Submit<S>>(
     scene: &Scene,
     pieces: &[Piece],
     caches: &[Option<&[ProcessedVertex]>],
+    scratch: &mut Vec<ProcessedVertex>,
 ) -> Result<(), Error> {
     let mut first_ids = Vec::with_capacity(scene.objects.len());
     let mut id = 0u32;
@@ -427,32 +428,27 @@ pub fn fill<const S: u32, K: Submit<S>>(
                 }
                 let id = first_ids[*i].wrapping_add(r.start as u32);
                 if let Some(c) = &o.clusters {
-                    // Its own scratch cache: the vertex stage skipped it.
-                    let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
+                    // The scratch cache: the vertex stage skipped it.
+                    let cache = scratch_for(scratch, o.positions.len());
                     // Without a fill, plain colours: no box is bounded.
                     match o.detail_fill {
-                        Some(_) => frame.submit_clusters(
-                            &o.mesh(),
-                            &o.mvp,
-                            &c.set(),
-                            c.cull,
-                            id,
-                            &mut cache,
-                        ),
+                        Some(_) => {
+                            frame.submit_clusters(&o.mesh(), &o.mvp, &c.set(), c.cull, id, cache)
+                        }
                         None => frame.submit_clusters(
                             &o.plain_mesh(),
                             &o.mvp,
                             &c.set(),
                             c.cull,
                             id,
-                            &mut cache,
+                            cache,
                         ),
                     }?;
                     continue;
                 }
                 if let Some(c) = &o.normal_classes {
-                    let mut cache = vec![ProcessedVertex::EMPTY; o.positions.len()];
-                    frame.submit_masked(&o.mesh(), &o.mvp, &c.set(), id, &mut cache)?;
+                    let cache = scratch_for(scratch, o.positions.len());
+                    frame.submit_masked(&o.mesh(), &o.mvp, &c.set(), id, cache)?;
                     continue;
                 }
                 // An object split among pieces draws its detail box (if
@@ -479,6 +475,17 @@ pub fn fill<const S: u32, K: Submit<S>>(
         }
     }
     Ok(())
+}
+
+/// The first `n` entries of `scratch`, grown to hold them: the cache of
+/// a clustered or masked object, kept from one frame to the next. What
+/// it holds is never read: the core processes the entries that the
+/// triangles it keeps read (its caches are scratch space).
+fn scratch_for(scratch: &mut Vec<ProcessedVertex>, n: usize) -> &mut [ProcessedVertex] {
+    if scratch.len() < n {
+        scratch.resize(n, ProcessedVertex::EMPTY);
+    }
+    &mut scratch[..n]
 }
 
 // ---------------------------------------------------------------------------
@@ -1021,8 +1028,14 @@ pub struct FramePipeline<const S: u32> {
     split: SetupSplit,
 }
 
-/// One frame's bins: offsets and items (see [`Frame::bin_tiles_with`]).
-type BinBuffers = (Vec<u32>, Vec<u32>);
+/// One setup chunk's buffers, kept from frame to frame: its bins'
+/// offsets and items (see [`Frame::bin_tiles_with`]), and the vertex
+/// cache of the clustered and masked objects it submits ([`fill`]).
+#[derive(Debug, Default)]
+struct BinBuffers {
+    bins: (Vec<u32>, Vec<u32>),
+    scratch: Vec<ProcessedVertex>,
+}
 
 /// One setup worker's frame, binned, when its building ended (before the
 /// binning) and when building began and binning ended: `Ok(Err(needed))`
@@ -1044,7 +1057,8 @@ fn build_chunk<'s, 'b, const S: u32>(
 ) -> Built<'s, 'b, S> {
     let start = Instant::now();
     let mut f = Frame::<S>::with_subpixel_bits(config, storage).map_err(|e| e.to_string())?;
-    match fill(&mut f, scene, pieces, caches) {
+    let BinBuffers { bins, scratch } = bins;
+    match fill(&mut f, scene, pieces, caches, scratch) {
         Ok(()) => {
             let built = Instant::now();
             let b = bin_growing::<S>(&f, tile.0, tile.1, bins)?;
@@ -2033,7 +2047,8 @@ mod tests {
                 for k in 0..n {
                     let mut storage = vec![SetupTriangle::EMPTY; 16];
                     let mut f = Frame::<8>::new(config, &mut storage).unwrap();
-                    fill(&mut f, &scene, &[Piece::Object(i, k..k + 1)], &caches).unwrap();
+                    let piece = [Piece::Object(i, k..k + 1)];
+                    fill(&mut f, &scene, &piece, &caches, &mut Vec::new()).unwrap();
                     let core = !f.triangles().is_empty();
                     kept_some[core as usize] = true;
                     // The object with triangle k first.

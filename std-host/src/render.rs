@@ -375,7 +375,7 @@ fn render_immediate<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result
                                 o.set_hiding(hiz);
                                 fill_occluded::<S, _, _>(&mut o, scene, &caches, &config)?;
                             } else {
-                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                                fill::<S, _>(&mut r, scene, &pieces, &cache_refs, &mut Vec::new())?;
                             }
                             (r.render_stats().pixels_written, r.stats())
                         }
@@ -383,7 +383,7 @@ fn render_immediate<const S: u32>(scene: &Scene, opts: &RenderOptions) -> Result
                             let mut none = NoDepth;
                             let mut r =
                                 StripRenderer::<_, _, S>::with_rect(config, rect, c, &mut none)?;
-                            fill::<S, _>(&mut r, scene, &pieces, &cache_refs)?;
+                            fill::<S, _>(&mut r, scene, &pieces, &cache_refs, &mut Vec::new())?;
                             (r.render_stats().pixels_written, r.stats())
                         }
                     };
