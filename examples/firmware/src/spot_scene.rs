@@ -204,6 +204,23 @@ pub fn herd_cell_model(c: usize) -> Mat4 {
     Mat4::translation(Vec3::new(x, 0.0, z)) * Mat4::rotation_y(yaw)
 }
 
+/// `(cos, sin)` of `j` eighths of a turn, `j` in `0..8`: the sweeps'
+/// directions.
+#[allow(dead_code)]
+const EIGHTHS: [(f32, f32); 8] = {
+    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
+    [
+        (1.0, 0.0),
+        (H, H),
+        (0.0, 1.0),
+        (-H, H),
+        (-1.0, 0.0),
+        (-H, -H),
+        (0.0, -1.0),
+        (H, -H),
+    ]
+};
+
 /// Cameras of the `herd-occlusion` builds' sweep: [`HERD_EYE`] turned
 /// about the vertical axis through the herd's centre by 45 degrees at a
 /// time: the host's `spots_camera(8 j, 64, 10)` for `j` in `0..8` (to
@@ -214,18 +231,7 @@ pub const HERD_SWEEP: usize = 8;
 /// The eye of the herd sweep's camera `j` (see [`HERD_SWEEP`]).
 #[allow(dead_code)]
 pub fn herd_sweep_eye(j: usize) -> Vec3 {
-    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
-    const TURNS: [(f32, f32); HERD_SWEEP] = [
-        (1.0, 0.0),
-        (H, H),
-        (0.0, 1.0),
-        (-H, H),
-        (-1.0, 0.0),
-        (-H, -H),
-        (0.0, -1.0),
-        (H, -H),
-    ];
-    let (c, s) = TURNS[j % HERD_SWEEP];
+    let (c, s) = EIGHTHS[j % EIGHTHS.len()];
     let (x, z) = (HERD_EYE.x, HERD_EYE.z);
     Vec3::new(x * c - z * s, HERD_EYE.y, x * s + z * c)
 }
@@ -247,18 +253,8 @@ pub const SWEEP: usize = 8;
 /// Object to clip space from the sweep's camera `k` (see [`SWEEP`]).
 #[allow(dead_code)]
 pub fn sweep_mvp(width: u32, height: u32, k: usize) -> Mat4 {
-    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
-    const DIRS: [(f32, f32); SWEEP] = [
-        (0.0, -1.0),
-        (H, -H),
-        (1.0, 0.0),
-        (H, H),
-        (0.0, 1.0),
-        (-H, H),
-        (-1.0, 0.0),
-        (-H, -H),
-    ];
-    let (sx, sz) = DIRS[k % SWEEP];
+    // From (0, -1), the direction from `TARGET` to `EYE`.
+    let (sx, sz) = EIGHTHS[(k % SWEEP + 6) % EIGHTHS.len()];
     let r = TARGET.z - EYE.z;
     let eye = Vec3::new(TARGET.x + r * sx, EYE.y, TARGET.z + r * sz);
     Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
