@@ -476,6 +476,39 @@ mod tests {
         ]
     }
 
+    /// Up to 40 positions: in two cases of three all within the unit
+    /// cube (most batches in view, the batch path), otherwise any
+    /// [`coord`]s.
+    fn positions() -> impl Strategy<Value = Vec<(f32, f32, f32)>> {
+        let near = -1.0f32..1.0;
+        prop_oneof![
+            2 => prop::collection::vec((near.clone(), near.clone(), near), 0..40),
+            1 => prop::collection::vec((coord(), coord(), coord()), 0..40),
+        ]
+    }
+
+    /// The property's cases do exercise the batch path: of the batches of
+    /// 256 cases drawn as it draws them, at least a quarter are batched.
+    #[test]
+    fn the_property_draws_batches_in_view() {
+        use proptest::strategy::ValueTree;
+        use proptest::test_runner::TestRunner;
+        let mut runner = TestRunner::deterministic();
+        let (mut batches, mut batched) = (0, 0);
+        for _ in 0..256 {
+            let mvp = camera().new_tree(&mut runner).unwrap().current();
+            let p = positions().new_tree(&mut runner).unwrap().current();
+            let p: Vec<Vec3> = p.into_iter().map(|(x, y, z)| Vec3::new(x, y, z)).collect();
+            let guard = crate::fixed::guard_band_ndc::<8>(320, 240);
+            let mut out = std::vec![ProcessedVertex::EMPTY; BATCH];
+            for b in p.chunks_exact(BATCH) {
+                batches += 1;
+                batched += process_batch::<8>(320, 240, guard, &mvp, b, &mut out) as u32;
+            }
+        }
+        assert!(batched * 4 >= batches, "{batched} of {batches} batched");
+    }
+
     /// A camera looking at the unit cube from 2 to 6 units away, or (one
     /// case in four) a matrix of arbitrary entries.
     fn camera() -> impl Strategy<Value = Mat4> {
@@ -528,7 +561,7 @@ mod tests {
         #[test]
         fn batches_equal_the_vertex_by_vertex_stage(
             mvp in camera(),
-            p in prop::collection::vec((coord(), coord(), coord()), 0..40),
+            p in positions(),
             (w, h) in (1u32..2048, 1u32..2048),
             extra in -10i32..10,
         ) {
