@@ -424,10 +424,12 @@ mod tests {
     use proptest::prelude::*;
     use std::vec::Vec;
 
-    /// Every bit of a processed vertex (NaN payloads included).
+    /// Every bit of a processed vertex, but a NaN's payload: Rust leaves
+    /// it unspecified (Miri picks one at random), and nothing reads it.
     fn bits(v: &ProcessedVertex) -> ([u32; 5], crate::fixed::SnappedVertex, u16, bool) {
         let p = v.pos;
-        let f = [p.x, p.y, p.z, p.w, v.inv_w].map(f32::to_bits);
+        let bits = |x: f32| if x.is_nan() { f32::NAN } else { x }.to_bits();
+        let f = [p.x, p.y, p.z, p.w, v.inv_w].map(bits);
         (f, v.snap, v.code, v.snapped)
     }
 
@@ -489,7 +491,10 @@ mod tests {
 
     /// The property's cases do exercise the batch path: of the batches of
     /// 256 cases drawn as it draws them, at least a quarter are batched.
+    /// (Not under Miri: it tests the test's cases, and takes minutes
+    /// there.)
     #[test]
+    #[cfg_attr(miri, ignore)]
     fn the_property_draws_batches_in_view() {
         use proptest::strategy::ValueTree;
         use proptest::test_runner::TestRunner;
@@ -552,7 +557,13 @@ mod tests {
     }
 
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(512))]
+        // Few cases under Miri (CI runs these unit tests there too), and no
+        // failure file, which Miri's isolation would refuse.
+        #![proptest_config(ProptestConfig {
+            cases: if cfg!(miri) { 8 } else { 2048 },
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        })]
 
         /// The batched vertex stage writes exactly what the vertex-by-vertex
         /// one does, bit for bit, at both subpixel precisions, for any
