@@ -351,7 +351,7 @@ pub(crate) fn process_vertices<const S: u32>(
 /// hosts (one AVX register); 1 (no batches) on 32-bit cores, which have
 /// no vector unit for it and where the per-vertex branches cost less than
 /// the batch's stores.
-const BATCH: usize = if cfg!(target_pointer_width = "64") {
+pub(crate) const BATCH: usize = if cfg!(target_pointer_width = "64") {
     8
 } else {
     1

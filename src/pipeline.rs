@@ -21,7 +21,7 @@ use crate::config::{Error, RasterMode};
 use crate::cull::{traverse, Cluster, ClusterCull, ClusterSet, Detail, Eye, Visit};
 use crate::fixed::{snap, SnappedVertex};
 use crate::math::{Mat4, Vec3, Vec4};
-use crate::mesh::{process_vertices, Mesh, ProcessedVertex, NONFINITE};
+use crate::mesh::{process_vertices, Mesh, ProcessedVertex, BATCH, NONFINITE};
 use crate::normal_mask::{BackMask, NormalClasses};
 use crate::setup::{inv_w3, setup, setup_geometry, triangulate, Rejected, SetupTriangle};
 use crate::shade::{Attributes, Varyings};
@@ -1161,16 +1161,19 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
 /// (once to mark the drawn clusters' vertices, once to draw them), and
 /// each walk tests every node it reaches, the size guard included.
 ///
-/// Every entry of `cache` is first marked stale (non-finite); then each
-/// drawn cluster's listed vertices still stale are processed, and its
-/// triangles run at once. A triangle reads only entries processed this
-/// frame: those of its cluster's list (shared ones processed once, by the
-/// first cluster drawn that lists them), or, where the list misses a
-/// vertex, a stale entry, counted as non-finite (the general path may
-/// then read an entry of an earlier frame: bad data either way). A
-/// non-finite vertex stays marked and is processed again, to the same
-/// entry, by every cluster that lists it. For data that passed
-/// validation the frame and the counts are those of the general path.
+/// Every entry of `cache` is first marked stale (non-finite); then, for
+/// each visit of the walk that draws clusters, their listed vertices still
+/// stale are processed (on 64-bit hosts gathered into batches,
+/// [`process_listed`]; one by one, cluster by cluster, elsewhere), and
+/// their triangles run at once. A triangle reads only entries processed
+/// this frame: those its cluster lists (shared ones processed once, by the
+/// first visit that lists them), or, where the list misses a vertex, an
+/// entry another cluster of the visit lists or a stale one, counted as
+/// non-finite (the general path may then read an entry of an earlier
+/// frame: bad data either way). A non-finite vertex stays marked and is
+/// processed again, to the same entry, by every visit that lists it. For
+/// data that passed validation the frame and the counts are those of the
+/// general path.
 #[allow(clippy::too_many_arguments)]
 fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized, A>(
     parts: Parts<'_, K>,
@@ -1191,24 +1194,43 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
     }
     let (clusters, list) = (set.clusters, set.vertices);
     let (mut drawn, mut skipped) = (Stats::default(), Stats::default());
+    // (Set up once a submission, not once a visit.)
+    let mut gather = Gather::new();
     traverse(set, eye.as_ref(), None, cull, |v| match v {
         Visit::Draw(a, b) => {
-            for k in clusters.get(a..b).unwrap_or(&[]) {
-                let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
-                for &id in ids.unwrap_or(&[]) {
-                    let id = id as usize;
-                    let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id)) else {
-                        continue;
-                    };
-                    if out.code & NONFINITE != 0 {
-                        process_vertices::<S>(
-                            c.width,
-                            c.height,
-                            stage.guard,
-                            mvp,
-                            core::slice::from_ref(p),
-                            core::slice::from_mut(out),
-                        );
+            let drawn_now = clusters.get(a..b).unwrap_or(&[]);
+            if BATCH > 1 {
+                // The visit's clusters' vertices first, gathered into
+                // batches (see `process_listed`).
+                process_listed::<S>(
+                    stage,
+                    mvp,
+                    mesh.positions,
+                    list,
+                    drawn_now,
+                    cache,
+                    &mut gather,
+                );
+            }
+            for k in drawn_now {
+                if BATCH == 1 {
+                    let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+                    for &id in ids.unwrap_or(&[]) {
+                        let id = id as usize;
+                        let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id))
+                        else {
+                            continue;
+                        };
+                        if out.code & NONFINITE != 0 {
+                            process_vertices::<S>(
+                                c.width,
+                                c.height,
+                                stage.guard,
+                                mvp,
+                                core::slice::from_ref(p),
+                                core::slice::from_mut(out),
+                            );
+                        }
                     }
                 }
                 let job = ProcessedJob {
@@ -1229,6 +1251,87 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
     });
     *stats += drawn;
     *stats += skipped;
+}
+
+/// Vertices gathered per call of the vertex stage by [`process_listed`]:
+/// four of its batches.
+const GATHER: usize = 4 * BATCH;
+
+/// The vertex stage of the stale entries of `cache` that `clusters` list
+/// (ids in `list`), on hosts whose vertex stage takes batches
+/// ([`BATCH`] > 1): their positions gathered [`GATHER`] at a time, each
+/// gathered entry marked processed (so a vertex the clusters share is
+/// gathered once), processed in one call and scattered back. The entries
+/// are those that processing them one by one gives (the batch is the
+/// same computation, `process_vertices`); a non-finite vertex is marked
+/// stale again, as that gives it, and processed again by the next
+/// cluster that lists it.
+fn process_listed<const S: u32>(
+    stage: &Stage,
+    mvp: &Mat4,
+    positions: &[Vec3],
+    list: &[u32],
+    clusters: &[Cluster],
+    cache: &mut [ProcessedVertex],
+    g: &mut Gather,
+) {
+    let c = &stage.config;
+    let Gather { ids, at, out } = g;
+    let mut n = 0;
+    let mut flush = |ids: &[usize], at: &[Vec3], cache: &mut [ProcessedVertex]| {
+        let out = out.get_mut(..ids.len()).unwrap_or(&mut []);
+        process_vertices::<S>(c.width, c.height, stage.guard, mvp, at, out);
+        for (&id, v) in ids.iter().zip(out.iter()) {
+            if let Some(e) = cache.get_mut(id) {
+                *e = *v;
+            }
+        }
+    };
+    for k in clusters {
+        let listed = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+        for &id in listed.unwrap_or(&[]) {
+            let id = id as usize;
+            let (Some(p), Some(e)) = (positions.get(id), cache.get_mut(id)) else {
+                continue;
+            };
+            if e.code & NONFINITE == 0 {
+                continue;
+            }
+            // Gathered: not gathered again before it is processed.
+            e.code = 0;
+            if let (Some(i), Some(a)) = (ids.get_mut(n), at.get_mut(n)) {
+                (*i, *a) = (id, *p);
+                n += 1;
+            }
+            if n == GATHER {
+                flush(&ids[..], &at[..], cache);
+                n = 0;
+            }
+        }
+    }
+    flush(
+        ids.get(..n).unwrap_or(&[]),
+        at.get(..n).unwrap_or(&[]),
+        cache,
+    );
+}
+
+/// [`process_listed`]'s buffers: the gathered ids and positions, and
+/// their processed vertices.
+struct Gather {
+    ids: [usize; GATHER],
+    at: [Vec3; GATHER],
+    out: [ProcessedVertex; GATHER],
+}
+
+impl Gather {
+    fn new() -> Self {
+        Gather {
+            ids: [0; GATHER],
+            at: [Vec3::ZERO; GATHER],
+            out: [ProcessedVertex::EMPTY; GATHER],
+        }
+    }
 }
 
 /// The triangles of clusters `a..b`.
