@@ -329,8 +329,12 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
                 return Ok(());
             }
         }
-        let drawn = |f: &mut dyn FnMut(&Cluster)| {
+        // The walk's visits, recorded (where they fit) so that drawing
+        // replays them instead of testing every node again.
+        let mut record = WalkRecord::new();
+        let mut drawn = |f: &mut dyn FnMut(&Cluster)| {
             traverse(set, eye.as_ref(), detail.as_ref(), cull, |v| {
+                record.push(v);
                 if let Visit::Draw(a, b) = v {
                     set.clusters
                         .get(a..b)
@@ -375,6 +379,7 @@ pub trait Submit<const S: u32 = 8, const N: usize = 3> {
             eye,
             detail,
             cull,
+            record: record.complete(),
         };
         run_job::<S, N, _, _>(self.parts(), &job)
     }
@@ -1009,6 +1014,104 @@ struct ClusterJob<'m, A> {
     eye: Option<Eye>,
     detail: Option<Detail>,
     cull: ClusterCull,
+    /// The visits of a walk with the same eye, detail and test, to
+    /// replay instead of walking again (`None`: walk).
+    record: Option<&'m [u32]>,
+}
+
+/// Visits a [`WalkRecord`] holds: 2048 (8 KB) on 64-bit hosts, enough
+/// for the Stanford bunny's 5,788 clusters; none on 32-bit cores, whose
+/// stack is small and whose firmware submits clusters through a strip
+/// renderer (one walk, no record).
+const RECORDED_VISITS: usize = if cfg!(target_pointer_width = "64") {
+    2048
+} else {
+    0
+};
+
+/// The visits of one walk of a validated cluster set ([`traverse`]), in
+/// order, up to [`RECORDED_VISITS`] of them. The visits of such a walk
+/// tile the clusters in order, so each is kept as where it ends (below
+/// `2^30`) and its kind in the top two bits: drawn, culled at a leaf or
+/// at an inner node. A draw, or a cull of the same kind, that continues
+/// the visit before it extends it (the same triangles are drawn, and the
+/// same counted as skipped). A walk with more visits, a detail drop (its
+/// node is not kept) or a visit that does not start where the one before
+/// ended is not recorded ([`WalkRecord::complete`] gives `None`).
+struct WalkRecord {
+    ends: [u32; RECORDED_VISITS],
+    len: usize,
+    end: usize,
+    overflow: bool,
+}
+
+/// [`WalkRecord`]'s kinds of visit, in the top two bits.
+const DRAWN: u32 = 0;
+const CULLED_LEAF: u32 = 1 << 30;
+const CULLED_INNER: u32 = 2 << 30;
+const KIND: u32 = 3 << 30;
+
+impl WalkRecord {
+    fn new() -> Self {
+        WalkRecord {
+            ends: [0; RECORDED_VISITS],
+            len: 0,
+            end: 0,
+            overflow: false,
+        }
+    }
+
+    fn push(&mut self, v: Visit) {
+        let (a, b, kind) = match v {
+            Visit::Draw(a, b) => (a, b, DRAWN),
+            Visit::Cull(a, b, inner) => (a, b, if inner { CULLED_INNER } else { CULLED_LEAF }),
+            Visit::Detail(..) => {
+                self.overflow = true;
+                return;
+            }
+        };
+        let fits = u32::try_from(b).ok().filter(|&b| b & KIND == 0);
+        let (Some(b32), false, true) = (fits, self.overflow, a == self.end && a <= b) else {
+            self.overflow = true;
+            return;
+        };
+        self.end = b;
+        if let Some(last) = self.len.checked_sub(1).and_then(|i| self.ends.get_mut(i)) {
+            if *last & KIND == kind {
+                *last = kind | b32;
+                return;
+            }
+        }
+        match self.ends.get_mut(self.len) {
+            Some(slot) => {
+                *slot = kind | b32;
+                self.len += 1;
+            }
+            None => self.overflow = true,
+        }
+    }
+
+    /// The visits, if the walk's all fitted.
+    fn complete(&self) -> Option<&[u32]> {
+        match self.overflow {
+            true => None,
+            false => self.ends.get(..self.len),
+        }
+    }
+}
+
+/// The visits `record` ([`WalkRecord::complete`]) holds, in order.
+fn replay(record: &[u32], mut f: impl FnMut(Visit)) {
+    let mut a = 0usize;
+    for &r in record {
+        let b = (r & !KIND) as usize;
+        f(match r & KIND {
+            DRAWN => Visit::Draw(a, b),
+            CULLED_LEAF => Visit::Cull(a, b, false),
+            _ => Visit::Cull(a, b, true),
+        });
+        a = b;
+    }
 }
 
 /// Why [`ClusterJob::visit`] skipped a run of clusters.
@@ -1048,7 +1151,7 @@ impl<A> ClusterJob<'_, A> {
         let clusters = self.set.clusters;
         let count = |a: usize, b: usize| triangles_of(clusters, a, b);
         let (eye, detail) = (self.eye.as_ref(), self.detail.as_ref());
-        traverse(self.set, eye, detail, self.cull, |v| match v {
+        let step = |v| match v {
             Visit::Draw(a, b) => {
                 for k in clusters.get(a..b).unwrap_or(&[]) {
                     let [t0, t1] = k.triangles.map(|v| v as usize);
@@ -1067,7 +1170,11 @@ impl<A> ClusterJob<'_, A> {
                 if inner { Skipped::Inner } else { Skipped::Leaf },
             )),
             Visit::Detail(a, b, node) => h(Step::Skip(count(a, b), Skipped::Detail(node))),
-        });
+        };
+        match self.record {
+            Some(record) => replay(record, step),
+            None => traverse(self.set, eye, detail, self.cull, step),
+        }
     }
 }
 
@@ -1574,7 +1681,64 @@ fn process_clipless<const N: usize, K: Sink<N> + ?Sized>(
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
+
+    fn replayed(r: &WalkRecord) -> Option<std::vec::Vec<Visit>> {
+        let mut out = std::vec::Vec::new();
+        replay(r.complete()?, |v| out.push(v));
+        Some(out)
+    }
+
+    #[test]
+    #[cfg(target_pointer_width = "64")]
+    fn a_walk_record_merges_runs_and_gives_up_where_it_cannot_replay() {
+        let mut r = WalkRecord::new();
+        for v in [
+            Visit::Draw(0, 2),
+            Visit::Draw(2, 3),
+            Visit::Cull(3, 5, false),
+            Visit::Cull(5, 6, false),
+            Visit::Cull(6, 9, true),
+            Visit::Draw(9, 9),
+            Visit::Draw(9, 12),
+            Visit::Cull(12, 13, false),
+        ] {
+            r.push(v);
+        }
+        let want = [
+            Visit::Draw(0, 3),
+            Visit::Cull(3, 6, false),
+            Visit::Cull(6, 9, true),
+            Visit::Draw(9, 12),
+            Visit::Cull(12, 13, false),
+        ];
+        assert_eq!(replayed(&r).as_deref(), Some(&want[..]));
+        // A detail drop (its node is not kept), a gap, a visit out of
+        // order or an end beyond 2^30: not recorded.
+        for bad in [
+            Visit::Detail(13, 14, 0),
+            Visit::Draw(14, 15),
+            Visit::Cull(12, 14, false),
+            Visit::Draw(13, 1 << 30),
+        ] {
+            let mut r2 = WalkRecord::new();
+            replay(r.complete().unwrap_or(&[]), |v| r2.push(v));
+            assert!(r2.complete().is_some());
+            r2.push(bad);
+            assert_eq!(replayed(&r2), None, "{bad:?}");
+        }
+        // More visits than it holds: none.
+        let mut r3 = WalkRecord::new();
+        for k in 0..=RECORDED_VISITS {
+            r3.push(if k % 2 == 0 {
+                Visit::Draw(k, k + 1)
+            } else {
+                Visit::Cull(k, k + 1, false)
+            });
+        }
+        assert_eq!(replayed(&r3), None);
+    }
 
     #[test]
     fn meshes_beyond_u32_triangles_are_refused() {
