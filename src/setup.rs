@@ -260,7 +260,19 @@ pub(crate) fn setup_geometry<const S: u32>(
     if px1 < 0 || py1 < 0 || px0 >= w || py0 >= h {
         return Err(Rejected::Offscreen);
     }
-    let clamp = |v: i64, hi: i64| v.clamp(0, hi) as u16;
+    // On 64-bit hosts `max` then `min`, not `Ord::clamp`: `hi` is at
+    // least 0 here, and `clamp`'s check of its bounds kept it out of line
+    // there (the sphere's triangle stage 4 % slower). The same on 32-bit
+    // cores saves the M4F's four cubes 3,320 instructions but moves the
+    // firmware's recorded split estimates past their 1 % check: left for
+    // a re-recording.
+    let clamp = |v: i64, hi: i64| {
+        (if cfg!(target_pointer_width = "64") {
+            v.max(0).min(hi)
+        } else {
+            v.clamp(0, hi)
+        }) as u16
+    };
     let edge32 = crate::raster::fits_i32(max_x - min_x, max_y - min_y);
     Ok(Geometry {
         x,
