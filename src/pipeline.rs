@@ -990,7 +990,22 @@ impl<A> ProcessedJob<'_, A> {
                     c.front_face,
                 ) {
                     Ok(g) => {
-                        let t = g.finish([a.inv_w, b.inv_w, d.inv_w], vars(), id);
+                        // On 64-bit hosts not `vars()`: LLVM kept that
+                        // closure out of line there, its varyings passed
+                        // through memory and read back wider than written
+                        // (the sphere's triangle stage 11 % slower). 32-bit
+                        // cores keep the closure, as their recorded split
+                        // estimates would move past their 1 % check.
+                        let v = match checked {
+                            Some(v) => v,
+                            None if cfg!(target_pointer_width = "64") => [
+                                attrs.get(i, idx[0]),
+                                attrs.get(i, idx[1]),
+                                attrs.get(i, idx[2]),
+                            ],
+                            None => vars(),
+                        };
+                        let t = g.finish([a.inv_w, b.inv_w, d.inv_w], v, id);
                         sink.take(&t);
                         stats.stored += 1;
                     }
