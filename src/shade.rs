@@ -142,7 +142,8 @@ impl Attributes<3> for MeshColors<'_> {
             MeshColors::PerVertex(cs) => idx.iter().all(|&k| (k as usize) < cs.len()),
         }
     }
-    #[inline]
+    #[cfg_attr(target_pointer_width = "64", inline(always))]
+    #[cfg_attr(not(target_pointer_width = "64"), inline)]
     fn get(&self, tri: usize, vertex: u32) -> [f32; 3] {
         rgb_f32(match *self {
             MeshColors::Uniform(c) => c,

@@ -73,7 +73,9 @@ impl microraster::Attributes<3> for ObjectAttributes<'_> {
     fn has(&self, tri: usize, idx: [u32; 3]) -> bool {
         self.colors.has(tri, idx)
     }
-    #[inline]
+    // (Always: a call returns the colour through memory, which the
+    // caller read back wider than written, a store-forwarding stall.)
+    #[inline(always)]
     fn get(&self, tri: usize, vertex: u32) -> [f32; 3] {
         self.colors.get(tri, vertex)
     }
