@@ -155,8 +155,15 @@ impl<const N: usize> Sink<N> for Store<'_, N> {
     fn take(&mut self, t: &SetupTriangle<N>) {
         if let Some(slot) = self.storage.get_mut(self.len) {
             *slot = *t;
-            // Once a frame, for every strip that draws it.
-            slot.flat_facts = crate::raster::flat_facts_of(t);
+            // Once a frame, for every strip that draws it. On 64-bit
+            // hosts not for a smooth triangle, which only a pixel type
+            // without shading draws by its flat rows: 0, "not found",
+            // has those rows find them (`raster::facts`).
+            slot.flat_facts = if cfg!(target_pointer_width = "64") && t.smooth {
+                0
+            } else {
+                crate::raster::flat_facts_of(t)
+            };
             self.len += 1;
         }
     }
