@@ -516,7 +516,7 @@ done
 # `Occluder` (`herd-occlusion`); both frames must be the herd's host
 # frame (host-checksums.txt `spot-flat-herd`), counts of record in
 # docs/embedded.md, and the occlusion build must hide something, and
-# print its sweep of 8 cameras (each frame drawn with the test and
+# print its sweep of 64 cameras (each frame drawn with the test and
 # without; the firmware fails if any pair differs).
 herd_rows=()
 for v in "${herd_variants[@]}"; do
@@ -526,7 +526,7 @@ for v in "${herd_variants[@]}"; do
       echo "FAIL: mps2-an386 $v hid no triangle"
       failed=1
     fi
-    if ! grep -E '^herd sweep of 8 cameras: hidden by occlusion before transform [1-9]' "$out"; then
+    if ! grep -E '^herd sweep of 64 cameras: hidden by occlusion before transform [1-9]' "$out"; then
       echo "FAIL: mps2-an386 $v printed no herd sweep that hid anything"
       failed=1
     fi
@@ -540,7 +540,7 @@ done
 # strip (`house-portals`); both frames must be the house drawn whole
 # (host-checksums.txt `house`, which std-host/tests/portal.rs computes
 # from the generator), counts of record in docs/embedded.md. The portal
-# build must skip something, and its sweep of 8 cameras compares each
+# build must skip something, and its sweep of 64 cameras compares each
 # culled frame with the whole one on the board (a difference fails it).
 house_rows=()
 house_sweep_rows=()

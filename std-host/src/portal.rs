@@ -382,7 +382,7 @@ pub const FIRMWARE_ROOMS: usize = HOUSE_ROOMS;
 /// --portals` reach 5.4 on average).
 pub const FIRMWARE_CAMERA: usize = 2;
 /// Cameras of the firmware's sweep: the first of [`house_camera`]'s.
-pub const FIRMWARE_SWEEP: usize = 8;
+pub const FIRMWARE_SWEEP: usize = 64;
 
 impl House {
     /// World to clip for `eye` towards `target`, as [`House::scene`] draws.

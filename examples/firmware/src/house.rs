@@ -18,7 +18,7 @@
 //! use over random houses and cameras), so the frame is the house drawn
 //! whole, which build.rs renders on the host (and the host test from the
 //! generator itself: host-checksums.txt `house`). Then a sweep of the
-//! host's first 8 cameras draws each frame culled and whole and compares
+//! host's 64 cameras draws each frame culled and whole and compares
 //! them on the board.
 //!
 //! The split is measured as the Spot builds measure it: geometry is the

@@ -204,34 +204,56 @@ pub fn herd_cell_model(c: usize) -> Mat4 {
     Mat4::translation(Vec3::new(x, 0.0, z)) * Mat4::rotation_y(yaw)
 }
 
-/// `(cos, sin)` of `j` eighths of a turn, `j` in `0..8`: the sweeps'
-/// directions.
+/// The cosine of `i` sixty-fourths of a turn, `i` in `0..=16` (a quarter
+/// turn), rounded to `f32` (`cos(i pi / 32)`; the eighth of a turn is
+/// `FRAC_1_SQRT_2`, the quarter exactly 0).
 #[allow(dead_code)]
-const EIGHTHS: [(f32, f32); 8] = {
-    const H: f32 = core::f32::consts::FRAC_1_SQRT_2;
-    [
-        (1.0, 0.0),
-        (H, H),
-        (0.0, 1.0),
-        (-H, H),
-        (-1.0, 0.0),
-        (-H, -H),
-        (0.0, -1.0),
-        (H, -H),
-    ]
-};
+const QUARTER: [f32; 17] = [
+    1.0,
+    0.995_184_7,
+    0.980_785_25,
+    0.956_940_35,
+    0.923_879_5,
+    0.881_921_3,
+    0.831_469_6,
+    0.773_010_43,
+    core::f32::consts::FRAC_1_SQRT_2,
+    0.634_393_3,
+    0.555_570_24,
+    0.471_396_74,
+    0.382_683_43,
+    0.290_284_66,
+    0.195_090_32,
+    0.098_017_14,
+    0.0,
+];
+
+/// `(cos, sin)` of `j` sixty-fourths of a turn, `j` in `0..64` (taken mod
+/// 64): the sweeps' directions, from [`QUARTER`] by the quarter turns'
+/// symmetries (`0.0 - x` negates without making a `-0.0`).
+#[allow(dead_code)]
+fn turn(j: usize) -> (f32, f32) {
+    let i = j % 16;
+    let (c, s) = (QUARTER[i], QUARTER[16 - i]);
+    match j / 16 % 4 {
+        0 => (c, s),
+        1 => (0.0 - s, c),
+        2 => (0.0 - c, 0.0 - s),
+        _ => (s, 0.0 - c),
+    }
+}
 
 /// Cameras of the `herd-occlusion` builds' sweep: [`HERD_EYE`] turned
-/// about the vertical axis through the herd's centre by 45 degrees at a
-/// time: the host's `spots_camera(8 j, 64, 10)` for `j` in `0..8` (to
-/// `f32` rounding), each looking at [`HERD_TARGET`].
+/// about the vertical axis through the herd's centre by a sixty-fourth of
+/// a turn at a time: the host's 64 cameras, `spots_camera(j, 64, 10)` for
+/// `j` in `0..64` (to `f32` rounding), each looking at [`HERD_TARGET`].
 #[allow(dead_code)]
-pub const HERD_SWEEP: usize = 8;
+pub const HERD_SWEEP: usize = 64;
 
 /// The eye of the herd sweep's camera `j` (see [`HERD_SWEEP`]).
 #[allow(dead_code)]
 pub fn herd_sweep_eye(j: usize) -> Vec3 {
-    let (c, s) = EIGHTHS[j % EIGHTHS.len()];
+    let (c, s) = turn(j);
     let (x, z) = (HERD_EYE.x, HERD_EYE.z);
     Vec3::new(x * c - z * s, HERD_EYE.y, x * s + z * c)
 }
@@ -245,16 +267,17 @@ pub fn herd_view(width: u32, height: u32, eye: Vec3) -> Mat4 {
 }
 
 /// Cameras of the cluster builds' sweep: eyes on the circle through
-/// [`EYE`] about the vertical axis through [`TARGET`], 45 degrees apart,
-/// at [`EYE`]'s height; the first is [`EYE`] itself.
+/// [`EYE`] about the vertical axis through [`TARGET`], a sixty-fourth of a
+/// turn (5.625 degrees) apart, at [`EYE`]'s height; the first is [`EYE`]
+/// itself (the sweep of 8 cameras before 2026-12-07 drew every eighth).
 #[allow(dead_code)]
-pub const SWEEP: usize = 8;
+pub const SWEEP: usize = 64;
 
 /// Object to clip space from the sweep's camera `k` (see [`SWEEP`]).
 #[allow(dead_code)]
 pub fn sweep_mvp(width: u32, height: u32, k: usize) -> Mat4 {
     // From (0, -1), the direction from `TARGET` to `EYE`.
-    let (sx, sz) = EIGHTHS[(k % SWEEP + 6) % EIGHTHS.len()];
+    let (sx, sz) = turn(k % SWEEP + 48);
     let r = TARGET.z - EYE.z;
     let eye = Vec3::new(TARGET.x + r * sx, EYE.y, TARGET.z + r * sz);
     Mat4::perspective(radians(45.0), width as f32 / height as f32, 1.0, 6.0)
