@@ -884,7 +884,7 @@ impl<R: Real, const N: usize> Shader<R, N> {
     /// Returns 1 if written.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn pixel<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>>(
+    fn pixel<C: PixelFormat, D: DepthBuffer + ?Sized, F: FragmentShader<N>, const LESS: bool>(
         &self,
         t: &SetupTriangle<N>,
         strip: &mut Strip<'_, C, D>,
@@ -894,11 +894,12 @@ impl<R: Real, const N: usize> Shader<R, N> {
         z32: u32,
         flat: C,
     ) -> u32 {
-        if D::ENABLED
-            && !strip
-                .depth
-                .test_and_set(idx, z32, strip.depth_func, strip.depth_write)
-        {
+        // `LESS`: the caller found `Less` with writes on (see `draw`).
+        let (func, write) = match LESS {
+            true => (DepthFunc::Less, true),
+            false => (strip.depth_func, strip.depth_write),
+        };
+        if D::ENABLED && !strip.depth.test_and_set(idx, z32, func, write) {
             return 0;
         }
         let value = if self.smooth {
@@ -932,11 +933,25 @@ pub(crate) fn draw<
     strip: &mut Strip<'_, C, D>,
     fragment: &F,
 ) -> u32 {
-    let written = match (D::WIDE, t.edge32) {
-        (true, true) => draw_in::<S, N, C, D, F, f64, i32>(t, strip, fragment),
-        (true, false) => draw_in::<S, N, C, D, F, f64, i64>(t, strip, fragment),
-        (false, true) => draw_in::<S, N, C, D, F, f32, i32>(t, strip, fragment),
-        (false, false) => draw_in::<S, N, C, D, F, f32, i64>(t, strip, fragment),
+    // On 64-bit hosts the common depth test (`Less`, writes on) gets
+    // its own copy of the pixel loops, so that no pixel dispatches on the
+    // test (a jump table a pixel: the tgx sphere's smooth spans). 32-bit
+    // cores keep one copy (flash).
+    let less = cfg!(not(target_pointer_width = "32"))
+        && D::ENABLED
+        && C::SHADED
+        && t.smooth
+        && strip.depth_func == DepthFunc::Less
+        && strip.depth_write;
+    let written = match (D::WIDE, t.edge32, less) {
+        (true, true, false) => draw_in::<S, N, C, D, F, f64, i32, false>(t, strip, fragment),
+        (true, false, false) => draw_in::<S, N, C, D, F, f64, i64, false>(t, strip, fragment),
+        (false, true, false) => draw_in::<S, N, C, D, F, f32, i32, false>(t, strip, fragment),
+        (false, false, false) => draw_in::<S, N, C, D, F, f32, i64, false>(t, strip, fragment),
+        (true, true, true) => draw_in::<S, N, C, D, F, f64, i32, true>(t, strip, fragment),
+        (true, false, true) => draw_in::<S, N, C, D, F, f64, i64, true>(t, strip, fragment),
+        (false, true, true) => draw_in::<S, N, C, D, F, f32, i32, true>(t, strip, fragment),
+        (false, false, true) => draw_in::<S, N, C, D, F, f32, i64, true>(t, strip, fragment),
     };
     if strip.track && written != 0 {
         // Every pixel `draw_in` writes lies in the triangle's box.
@@ -955,6 +970,7 @@ fn draw_in<
     F: FragmentShader<N>,
     R: Real,
     T: EdgeInt,
+    const LESS: bool,
 >(
     t: &SetupTriangle<N>,
     strip: &mut Strip<'_, C, D>,
@@ -1035,7 +1051,7 @@ fn draw_in<
                     {
                         shader.resync(t, e, &mut acc);
                     }
-                    written += shader.pixel(
+                    written += shader.pixel::<C, D, F, LESS>(
                         t,
                         strip,
                         fragment,
@@ -1082,7 +1098,16 @@ fn draw_in<
                     if (n - lo).is_multiple_of(resync(N)) && n != lo {
                         shader.resync(t, e, &mut acc);
                     }
-                    written += shader.pixel(t, strip, fragment, base + n, &acc, D::key_of(z), flat);
+                    let key = D::key_of(z);
+                    written += shader.pixel::<C, D, F, LESS>(
+                        t,
+                        strip,
+                        fragment,
+                        base + n,
+                        &acc,
+                        key,
+                        flat,
+                    );
                     z = z.wrapping_add(shader.dz_fixed);
                     e[0] += edges[0].step_x;
                     e[1] += edges[1].step_x;
@@ -1192,7 +1217,7 @@ fn window_rows<
                         shader.resync(t, e, &mut acc);
                     }
                     if k >= wlo {
-                        written += shader.pixel(
+                        written += shader.pixel::<C, D, F, false>(
                             t,
                             strip,
                             fragment,
@@ -1247,8 +1272,15 @@ fn window_rows<
                         if (n - lo_n).is_multiple_of(r) && n != lo_n && n != p {
                             shader.resync(t, e, &mut acc);
                         }
-                        written +=
-                            shader.pixel(t, strip, fragment, at(row, n), &acc, D::key_of(z), flat);
+                        written += shader.pixel::<C, D, F, false>(
+                            t,
+                            strip,
+                            fragment,
+                            at(row, n),
+                            &acc,
+                            D::key_of(z),
+                            flat,
+                        );
                         z = z.wrapping_add(shader.dz_fixed);
                         e[0] += edges[0].step_x;
                         e[1] += edges[1].step_x;
