@@ -58,8 +58,28 @@ const fn channel_table(bits: u32, pos: u32) -> [u16; 256] {
     t
 }
 
+// On 64-bit hosts the three tables are one static, so that a pixel loop
+// holds one address for them (a position-independent binary loads each
+// static's address from its global offset table: the tgx sphere's smooth
+// spans had loaded three a pixel). 32-bit cores keep three statics (their
+// recorded instruction counts and split estimates).
+#[cfg(not(target_pointer_width = "32"))]
+static RGB565: [[u16; 256]; 3] = [
+    channel_table(5, 11),
+    channel_table(6, 5),
+    channel_table(5, 0),
+];
+#[cfg(not(target_pointer_width = "32"))]
+const RGB565_R: &[u16; 256] = &RGB565[0];
+#[cfg(not(target_pointer_width = "32"))]
+const RGB565_G: &[u16; 256] = &RGB565[1];
+#[cfg(not(target_pointer_width = "32"))]
+const RGB565_B: &[u16; 256] = &RGB565[2];
+#[cfg(target_pointer_width = "32")]
 static RGB565_R: [u16; 256] = channel_table(5, 11);
+#[cfg(target_pointer_width = "32")]
 static RGB565_G: [u16; 256] = channel_table(6, 5);
+#[cfg(target_pointer_width = "32")]
 static RGB565_B: [u16; 256] = channel_table(5, 0);
 
 impl PixelFormat for Gray8 {
