@@ -998,11 +998,7 @@ impl<A> ProcessedJob<'_, A> {
                         // estimates would move past their 1 % check.
                         let v = match checked {
                             Some(v) => v,
-                            None if cfg!(target_pointer_width = "64") => [
-                                attrs.get(i, idx[0]),
-                                attrs.get(i, idx[1]),
-                                attrs.get(i, idx[2]),
-                            ],
+                            None if cfg!(target_pointer_width = "64") => [var(0), var(1), var(2)],
                             None => vars(),
                         };
                         let t = g.finish([a.inv_w, b.inv_w, d.inv_w], v, id);
