@@ -61,6 +61,11 @@ step "firmware crate: rustfmt and clippy (it is outside the workspace)"
 (
   cd examples/firmware
   cargo fmt --check
+  # The target dir first: on a fresh clone the two clippy lists below
+  # would both create it, each cargo by a temporary dir renamed into
+  # place, and the rename of `target` can drop the other's `target/lint-b`
+  # ("No such file or directory", seen 2026-12-07).
+  mkdir -p target
   lint() { # TARGET [CARGO ARGS...]: one build's clippy, warnings denied
     local t=$1
     shift
