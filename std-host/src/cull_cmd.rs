@@ -12,7 +12,15 @@
 //! quotes the median per-frame time over the rounds with its range. The
 //! geometry stage is the submission alone (object cull, cluster tests,
 //! transform, clip, setup into a frame); the frame adds drawing the whole
-//! frame on one thread with a `u16` depth buffer. `t/r` is measured: one
+//! frame on one thread with a `u16` depth buffer. Three rows bound what
+//! any such culling can gain: per camera, the clustered mesh cut (outside
+//! the timing) to the triangles of the clusters that culling volumes over
+//! the tree draw, to all but those per-triangle culling culls by winding,
+//! and to those it sets up, each cut submitted per triangle with only its
+//! vertices: the tree's cut with its tests free, a free and perfect
+//! culling by facing, and a free and perfect culler (each cut, a copy of
+//! the mesh for one camera, is submitted once untimed before it is timed,
+//! so that it is in cache as the shared mesh is). `t/r` is measured: one
 //! node test (over the leaves and the sample eyes) against the
 //! geometry-stage time per triangle of per-triangle culling.
 
@@ -55,24 +63,46 @@ pub enum Method {
     /// Normal masks of this many partitions a side, on the clustered
     /// mesh's triangle order (`--normal-masks`).
     Mask(u8),
+    /// The floor of every culling before transform: per camera, the
+    /// clustered mesh cut to the triangles that per-triangle culling sets
+    /// up, with only their vertices ([`Kept`]), submitted per triangle. A
+    /// perfect culler that cost nothing would submit that; its cut is made
+    /// outside the timing.
+    Floor,
+    /// What culling volumes over the tree would cost if their tests and
+    /// bookkeeping were free: like [`Method::Floor`], the triangles of the
+    /// clusters [`Method::VolumesTree`] draws.
+    FloorVolumes,
+    /// The floor of culling by facing (every test here): like
+    /// [`Method::Floor`], the triangles that per-triangle culling does not
+    /// cull by winding (back faces left out, all else submitted).
+    FloorFacing,
 }
 
 impl Method {
     /// All, in order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 9] = [
         Method::Source,
         Method::Clustered,
         Method::Volumes,
         Method::VolumesTree,
         Method::Cones,
         Method::ConesTree,
+        Method::FloorVolumes,
+        Method::FloorFacing,
+        Method::Floor,
     ];
 
     /// The setting (detail culling for [`Method::Detail`] is in the
     /// frame's `Config::detail`).
     fn cull(self) -> Option<ClusterCull> {
         let (test, hierarchy) = match self {
-            Method::Source | Method::Clustered | Method::Mask(_) => return None,
+            Method::Source
+            | Method::Clustered
+            | Method::Mask(_)
+            | Method::Floor
+            | Method::FloorVolumes
+            | Method::FloorFacing => return None,
             Method::Volumes => (ClusterTest::Volumes, false),
             Method::VolumesTree | Method::Detail | Method::DetailBoxes => {
                 (ClusterTest::Volumes, true)
@@ -94,6 +124,9 @@ impl Method {
             Method::Detail => "culling volumes, tree, detail",
             Method::DetailBoxes => "culling volumes, tree, boxes for detail",
             Method::Mask(n) => return format!("normal masks, N = {n}"),
+            Method::Floor => "floor: only the triangles set up (a free, perfect culler)",
+            Method::FloorVolumes => "culling volumes, tree, free: their cut, no test",
+            Method::FloorFacing => "floor of culling by facing: all but the back faces, free",
         };
         s.to_string()
     }
@@ -265,6 +298,102 @@ struct Case<'a> {
     config: Config,
     /// The varyings of detail culling's boxes ([`Method::DetailBoxes`]).
     fill: Option<[f32; 3]>,
+    /// Per camera, the mesh a perfect culler submits ([`Method::Floor`]),
+    /// in place of `mesh`.
+    kept: Option<&'a [Kept]>,
+}
+
+/// The triangles of a mesh that one camera keeps by some rule ([`Cut`]),
+/// in their order and colours, with only the vertices they use.
+struct Kept {
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    colors: Vec<Rgb888>,
+}
+
+/// Which triangles a floor row keeps.
+#[derive(Clone, Copy)]
+enum Cut {
+    /// Those per-triangle culling sets up (stores a piece of).
+    SetUp,
+    /// Those per-triangle culling does not cull by winding.
+    NotBack,
+    /// Those of the clusters that culling volumes over the tree draw.
+    Volumes,
+}
+
+impl Kept {
+    /// Cuts `mesh` (colours per triangle, clustered as `clustered`) to
+    /// what `cut` keeps from `mvp`. For [`Cut::SetUp`] and
+    /// [`Cut::NotBack`] each triangle alone is submitted, in clip space as
+    /// [`Mesh::triangle`] gives it (the same `f32` operations as the
+    /// cached path's vertex stage), and its counts decide.
+    fn cut(
+        mesh: &Mesh<'_, MeshColors<'_>>,
+        colors: &[Rgb888],
+        clustered: &ClusteredMesh,
+        mvp: &Mat4,
+        config: Config,
+        cut: Cut,
+        storage: &mut [SetupTriangle],
+    ) -> Result<Kept, String> {
+        let mut keep = vec![false; mesh.indices.len()];
+        if let Cut::Volumes = cut {
+            let eye = Eye::for_frame::<8>(mvp, &config);
+            let eye = eye.map(|e| mesh.bounds.map_or(e, |b| e.within(&b)));
+            let cull = Method::VolumesTree.cull().ok_or("no cluster test")?;
+            clustered.set().visit(eye.as_ref(), None, cull, |v| {
+                if let Visit::Draw(a, b) = v {
+                    for k in &clustered.clusters[a..b] {
+                        let [t0, t1] = k.triangles.map(|t| t as usize);
+                        keep[t0..t1].fill(true);
+                    }
+                }
+            });
+        } else {
+            let mut frame = Frame::new(config, storage).map_err(|e| e.to_string())?;
+            for (i, k) in keep.iter_mut().enumerate() {
+                let Some(tri) = mesh.triangle::<3>(i, mvp) else {
+                    return Err(format!("triangle {i} indexes past the mesh"));
+                };
+                frame.clear();
+                frame
+                    .submit_triangle(tri, i as u32)
+                    .map_err(|e| e.to_string())?;
+                let s = frame.stats();
+                *k = match cut {
+                    Cut::NotBack => s.culled_backface == 0,
+                    _ => s.stored > 0,
+                };
+            }
+        }
+        let mut remap = vec![u32::MAX; mesh.positions.len()];
+        let mut kept = Kept {
+            positions: Vec::new(),
+            indices: Vec::new(),
+            colors: Vec::new(),
+        };
+        for ((t, &c), _) in mesh
+            .indices
+            .iter()
+            .zip(colors)
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+        {
+            let mut k = [0u32; 3];
+            for (slot, &v) in k.iter_mut().zip(t) {
+                let r = &mut remap[v as usize];
+                if *r == u32::MAX {
+                    *r = kept.positions.len() as u32;
+                    kept.positions.push(mesh.positions[v as usize]);
+                }
+                *slot = *r;
+            }
+            kept.indices.push(k);
+            kept.colors.push(c);
+        }
+        Ok(kept)
+    }
 }
 
 impl Method {
@@ -279,9 +408,23 @@ impl Method {
 fn submit(
     frame: &mut Frame<'_>,
     case: &Case<'_>,
+    camera: usize,
     mvp: &Mat4,
     cache: &mut [ProcessedVertex],
 ) -> Result<Stats, String> {
+    if let Some(kept) = case.kept {
+        let k = kept.get(camera).ok_or("no cut mesh for the camera")?;
+        let mesh = Mesh {
+            positions: &k.positions,
+            indices: &k.indices,
+            attributes: MeshColors::PerTriangle(&k.colors),
+            bounds: case.mesh.bounds,
+        };
+        frame
+            .submit_mesh_cached(&mesh, mvp, 0, cache)
+            .map_err(|e| e.to_string())?;
+        return Ok(frame.stats());
+    }
     match (case.set, case.classes) {
         (Some((c, cull)), _) if case.fill.is_some() => {
             let mesh = Mesh {
@@ -304,7 +447,10 @@ fn submit(
 }
 
 /// Vertices a frame transforms.
-fn vertices_transformed(case: &Case<'_>, mvp: &Mat4) -> usize {
+fn vertices_transformed(case: &Case<'_>, camera: usize, mvp: &Mat4) -> usize {
+    if let Some(kept) = case.kept {
+        return kept.get(camera).map_or(0, |k| k.positions.len());
+    }
     if let Some(c) = case.classes {
         let mask = BackMask::for_frame::<8>(mvp, &case.config, None, &c.set());
         let mut seen = vec![false; case.mesh.positions.len()];
@@ -391,6 +537,7 @@ fn measure(
         classes: None,
         config,
         fill: None,
+        kept: None,
     };
     let mut methods = Method::ALL.to_vec();
     if args.detail > 0 {
@@ -402,6 +549,16 @@ fn measure(
         .map(|&n| normal_mask::build(&clustered.positions, &clustered.indices, n))
         .collect::<Result<_, _>>()?;
     methods.extend(args.normal_masks.iter().map(|&n| Method::Mask(n)));
+    // The floor's meshes, cut per camera before any timing (a triangle
+    // makes at most `MAX_PIECES` pieces, and the frame is emptied after
+    // each that stores one).
+    let mut one = vec![SetupTriangle::EMPTY; 2 * microraster::MAX_PIECES];
+    let mut cut = |cut| -> Result<Vec<Kept>, String> {
+        mvps.iter()
+            .map(|mvp| Kept::cut(&cmesh, &colors, clustered, mvp, config, cut, &mut one))
+            .collect()
+    };
+    let kept = [cut(Cut::Volumes)?, cut(Cut::NotBack)?, cut(Cut::SetUp)?];
     let cases: Vec<Case<'_>> = methods
         .iter()
         .map(|m| Case {
@@ -424,6 +581,12 @@ fn measure(
                 ..config
             },
             fill: (*m == Method::DetailBoxes).then_some([255.0; 3]),
+            kept: match m {
+                Method::FloorVolumes => Some(&kept[0][..]),
+                Method::FloorFacing => Some(&kept[1][..]),
+                Method::Floor => Some(&kept[2][..]),
+                _ => None,
+            },
         })
         .collect();
     // Room for two pieces a triangle, and boxes' pieces.
@@ -452,12 +615,12 @@ fn measure(
         })
         .collect();
     let cams = mvps.len().max(1) as f64;
-    for mvp in &mvps {
+    for (camera, mvp) in mvps.iter().enumerate() {
         let mut want: Option<(Vec<u8>, Vec<Rgb888>)> = None;
         let mut want_white: Option<(Vec<u8>, Vec<Rgb888>)> = None;
         if methods.iter().any(|m| m.lossy()) {
             let mut frame = Frame::new(config, &mut storage).map_err(|e| e.to_string())?;
-            submit(&mut frame, &reference_white, mvp, &mut cache)?;
+            submit(&mut frame, &reference_white, camera, mvp, &mut cache)?;
             color.fill(Rgb888::BLACK);
             depth.fill(u16::MAX);
             frame
@@ -469,16 +632,23 @@ fn measure(
         }
         for (row, case) in rows.iter_mut().zip(&cases) {
             let mut frame = Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
-            let s = submit(&mut frame, case, mvp, &mut cache)?;
+            let s = submit(&mut frame, case, camera, mvp, &mut cache)?;
             color.fill(Rgb888::BLACK);
             depth.fill(u16::MAX);
             frame
                 .render_rows(0, h, &mut color, &mut depth[..])
                 .map_err(|e| e.to_string())?;
-            let skipped = s.culled_cluster + s.culled_hierarchy + s.culled_detail + s.culled_mask;
-            row.triangles_to_transform += (s.submitted - skipped) as f64 / cams;
-            row.removed_before_transform += skipped as f64 / s.submitted.max(1) as f64 / cams;
-            row.vertices_transformed += vertices_transformed(case, mvp) as f64 / cams;
+            let mut skipped =
+                s.culled_cluster + s.culled_hierarchy + s.culled_detail + s.culled_mask;
+            let mut submitted = s.submitted;
+            if case.kept.is_some() {
+                // What the perfect culler left out was never submitted.
+                submitted = cmesh.indices.len() as u64;
+                skipped = submitted.saturating_sub(s.submitted);
+            }
+            row.triangles_to_transform += (submitted - skipped) as f64 / cams;
+            row.removed_before_transform += skipped as f64 / submitted.max(1) as f64 / cams;
+            row.vertices_transformed += vertices_transformed(case, camera, mvp) as f64 / cams;
             row.triangles_set_up += s.stored as f64 / cams;
             if row.method != Method::Source {
                 let mut bytes: Vec<u8> = color.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
@@ -508,10 +678,18 @@ fn measure(
     for _ in 0..rounds {
         for (k, case) in cases.iter().enumerate() {
             let (mut g, mut f) = (0.0f64, 0.0f64);
-            for mvp in &mvps {
+            for (camera, mvp) in mvps.iter().enumerate() {
+                if case.kept.is_some() {
+                    // A cut is a copy of the mesh for this camera alone:
+                    // submitted once untimed, it is in cache as the mesh
+                    // every other row shares over the cameras is.
+                    let mut frame =
+                        Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
+                    submit(&mut frame, case, camera, mvp, &mut cache)?;
+                }
                 let t0 = Instant::now();
                 let mut frame = Frame::new(case.config, &mut storage).map_err(|e| e.to_string())?;
-                submit(&mut frame, case, mvp, &mut cache)?;
+                submit(&mut frame, case, camera, mvp, &mut cache)?;
                 let t1 = Instant::now();
                 color.fill(Rgb888::BLACK);
                 depth.fill(u16::MAX);
