@@ -1279,19 +1279,19 @@ impl<const N: usize, A: Attributes<N>> Job<N> for ClusterJob<'_, A> {
 /// (once to mark the drawn clusters' vertices, once to draw them), and
 /// each walk tests every node it reaches, the size guard included.
 ///
-/// Every entry of `cache` is first marked stale (non-finite); then, for
-/// each visit of the walk that draws clusters, their listed vertices still
-/// stale are processed (on 64-bit hosts gathered into batches,
-/// [`process_listed`]; one by one, cluster by cluster, elsewhere), and
-/// their triangles run at once. A triangle reads only entries processed
-/// this frame: those its cluster lists (shared ones processed once, by the
-/// first visit that lists them), or, where the list misses a vertex, an
-/// entry another cluster of the visit lists or a stale one, counted as
-/// non-finite (the general path may then read an entry of an earlier
-/// frame: bad data either way). A non-finite vertex stays marked and is
-/// processed again, to the same entry, by every visit that lists it. For
-/// data that passed validation the frame and the counts are those of the
-/// general path.
+/// On 64-bit hosts the drawn clusters' vertices are gathered over visits
+/// and processed in full batches before their triangles run
+/// ([`GatheredWalk`]); a vertex gathered once is not gathered again (a
+/// bitset marks it, or, in a mesh of more than [`SEEN`] vertices, its cache
+/// entry, all of which are first marked stale). Elsewhere every entry of
+/// `cache` is first marked stale (non-finite); then, for each visit of the
+/// walk that draws clusters, their listed vertices still stale are
+/// processed one by one, cluster by cluster, and their triangles run at
+/// once. A triangle whose cluster's list misses one of its vertices (bad
+/// data) may read a stale entry, counted as non-finite, or one of an
+/// earlier frame, as in the general path; a wrong triangle, never a read
+/// out of bounds. For data that passed validation the frame and the counts
+/// are those of the general path.
 #[allow(clippy::too_many_arguments)]
 fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized, A>(
     parts: Parts<'_, K>,
@@ -1307,48 +1307,58 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
 {
     let Parts { stage, stats, sink } = parts;
     let c = &stage.config;
-    for v in cache.iter_mut() {
-        v.code = NONFINITE;
+    // (A walk that marks what it gathers in a bitset needs no marks.)
+    if BATCH == 1 || cache.len() > SEEN {
+        for v in cache.iter_mut() {
+            v.code = NONFINITE;
+        }
     }
     let (clusters, list) = (set.clusters, set.vertices);
     let (mut drawn, mut skipped) = (Stats::default(), Stats::default());
-    // (Set up once a submission, not once a visit.)
-    let mut gather = Gather::new();
+    if BATCH > 1 {
+        let mut walk = GatheredWalk::new(cache.len());
+        traverse(set, eye.as_ref(), None, cull, |v| match v {
+            Visit::Draw(a, b) => {
+                let drawn_now = clusters.get(a..b).unwrap_or(&[]);
+                walk.gather::<S>(stage, mvp, mesh.positions, list, drawn_now, cache);
+                if walk.hold(a, b) {
+                    walk.run::<S, N, K, A>(
+                        stage, mvp, mesh, first_id, clusters, cache, &mut drawn, sink,
+                    );
+                }
+            }
+            Visit::Cull(a, b, inner) => {
+                let why = if inner { Skipped::Inner } else { Skipped::Leaf };
+                count_skipped(&mut skipped, triangles_of(clusters, a, b), why);
+            }
+            // No detail culling here.
+            Visit::Detail(..) => {}
+        });
+        walk.run::<S, N, K, A>(
+            stage, mvp, mesh, first_id, clusters, cache, &mut drawn, sink,
+        );
+        *stats += drawn;
+        *stats += skipped;
+        return;
+    }
     traverse(set, eye.as_ref(), None, cull, |v| match v {
         Visit::Draw(a, b) => {
-            let drawn_now = clusters.get(a..b).unwrap_or(&[]);
-            if BATCH > 1 {
-                // The visit's clusters' vertices first, gathered into
-                // batches (see `process_listed`).
-                process_listed::<S>(
-                    stage,
-                    mvp,
-                    mesh.positions,
-                    list,
-                    drawn_now,
-                    cache,
-                    &mut gather,
-                );
-            }
-            for k in drawn_now {
-                if BATCH == 1 {
-                    let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
-                    for &id in ids.unwrap_or(&[]) {
-                        let id = id as usize;
-                        let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id))
-                        else {
-                            continue;
-                        };
-                        if out.code & NONFINITE != 0 {
-                            process_vertices::<S>(
-                                c.width,
-                                c.height,
-                                stage.guard,
-                                mvp,
-                                core::slice::from_ref(p),
-                                core::slice::from_mut(out),
-                            );
-                        }
+            for k in clusters.get(a..b).unwrap_or(&[]) {
+                let ids = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+                for &id in ids.unwrap_or(&[]) {
+                    let id = id as usize;
+                    let (Some(p), Some(out)) = (mesh.positions.get(id), cache.get_mut(id)) else {
+                        continue;
+                    };
+                    if out.code & NONFINITE != 0 {
+                        process_vertices::<S>(
+                            c.width,
+                            c.height,
+                            stage.guard,
+                            mvp,
+                            core::slice::from_ref(p),
+                            core::slice::from_mut(out),
+                        );
                     }
                 }
                 let job = ProcessedJob {
@@ -1371,83 +1381,200 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
     *stats += skipped;
 }
 
-/// Vertices gathered per call of the vertex stage by [`process_listed`]:
-/// four of its batches.
-const GATHER: usize = 4 * BATCH;
+/// Vertices that [`GatheredWalk`] gathers before it processes them:
+/// sixteen of the vertex stage's batches.
+const GATHER: usize = 16 * BATCH;
 
-/// The vertex stage of the stale entries of `cache` that `clusters` list
-/// (ids in `list`), on hosts whose vertex stage takes batches
-/// ([`BATCH`] > 1): their positions gathered [`GATHER`] at a time, each
-/// gathered entry marked processed (so a vertex the clusters share is
-/// gathered once), processed in one call and scattered back. The entries
-/// are those that processing them one by one gives (the batch is the
-/// same computation, `process_vertices`); a non-finite vertex is marked
-/// stale again, as that gives it, and processed again by the next
-/// cluster that lists it.
-fn process_listed<const S: u32>(
-    stage: &Stage,
-    mvp: &Mat4,
-    positions: &[Vec3],
-    list: &[u32],
-    clusters: &[Cluster],
-    cache: &mut [ProcessedVertex],
-    g: &mut Gather,
-) {
-    let c = &stage.config;
-    let Gather { ids, at, out } = g;
-    let mut n = 0;
-    let mut flush = |ids: &[usize], at: &[Vec3], cache: &mut [ProcessedVertex]| {
-        let out = out.get_mut(..ids.len()).unwrap_or(&mut []);
-        process_vertices::<S>(c.width, c.height, stage.guard, mvp, at, out);
-        for (&id, v) in ids.iter().zip(out.iter()) {
-            if let Some(e) = cache.get_mut(id) {
-                *e = *v;
-            }
-        }
-    };
-    for k in clusters {
-        let listed = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
-        for &id in listed.unwrap_or(&[]) {
-            let id = id as usize;
-            let (Some(p), Some(e)) = (positions.get(id), cache.get_mut(id)) else {
-                continue;
-            };
-            if e.code & NONFINITE == 0 {
-                continue;
-            }
-            // Gathered: not gathered again before it is processed.
-            e.code = 0;
-            if let (Some(i), Some(a)) = (ids.get_mut(n), at.get_mut(n)) {
-                (*i, *a) = (id, *p);
-                n += 1;
-            }
-            if n == GATHER {
-                flush(&ids[..], &at[..], cache);
-                n = 0;
-            }
-        }
-    }
-    flush(
-        ids.get(..n).unwrap_or(&[]),
-        at.get(..n).unwrap_or(&[]),
-        cache,
-    );
-}
+/// Visits whose clusters [`GatheredWalk`] holds back, at most, until their
+/// vertices are processed.
+const HELD: usize = 32;
 
-/// [`process_listed`]'s buffers: the gathered ids and positions, and
-/// their processed vertices.
-struct Gather {
+/// Vertices of a mesh that [`GatheredWalk`] marks as gathered with a bit
+/// each (8 KB); in a larger mesh a cache entry is marked instead.
+const SEEN: usize = 65_536;
+
+/// The vertex stage of [`submit_clusters_in_one_walk`] on hosts whose
+/// vertex stage takes batches ([`BATCH`] > 1). Each drawn cluster's listed
+/// vertices not yet gathered this walk are gathered (their positions and
+/// ids, up to [`GATHER`]; a vertex the clusters share is gathered once,
+/// marked in a bitset, not in the cache, where the mesh has at most
+/// [`SEEN`] vertices) and processed in full batches, then scattered to the
+/// cache. The visits' clusters are held (up to [`HELD`] runs, adjacent
+/// visits merged) and their triangles run in visit order, each run in one
+/// call, once the vertices gathered for them are processed: when half of
+/// [`GATHER`] are waiting, when [`HELD`] runs are, and at the end. The
+/// entries are those that processing them one by one gives (the batch is
+/// the same computation, `process_vertices`); a non-finite vertex is
+/// processed once and its entry read as non-finite by every triangle.
+struct GatheredWalk {
     ids: [usize; GATHER],
     at: [Vec3; GATHER],
     out: [ProcessedVertex; GATHER],
+    /// Entries gathered.
+    n: usize,
+    /// One bit a vertex, set when it is gathered; empty for a mesh of
+    /// more than [`SEEN`] vertices.
+    seen: [u64; SEEN / 64],
+    bits: bool,
+    /// The held runs of clusters.
+    held: [(usize, usize); HELD],
+    runs: usize,
 }
 
-impl Gather {
-    fn new() -> Self {
-        Gather {
+impl GatheredWalk {
+    fn new(vertices: usize) -> Self {
+        GatheredWalk {
             ids: [0; GATHER],
             at: [Vec3::ZERO; GATHER],
             out: [ProcessedVertex::EMPTY; GATHER],
+            n: 0,
+            seen: [0; SEEN / 64],
+            bits: vertices <= SEEN,
+            held: [(0, 0); HELD],
+            runs: 0,
+        }
+    }
+
+    /// Gathers the vertices `clusters` list that no earlier cluster of the
+    /// walk did, processing them whenever [`GATHER`] are waiting. With the
+    /// bitset, every listed vertex is written to the next slot and the
+    /// count advances only for a fresh one (about half are shared: no
+    /// branch on it).
+    fn gather<const S: u32>(
+        &mut self,
+        stage: &Stage,
+        mvp: &Mat4,
+        positions: &[Vec3],
+        list: &[u32],
+        clusters: &[Cluster],
+        cache: &mut [ProcessedVertex],
+    ) {
+        let GatheredWalk {
+            ids,
+            at,
+            out,
+            n,
+            seen,
+            bits,
+            ..
+        } = self;
+        let mut m = *n;
+        for k in clusters {
+            let listed = list.get(k.vertices[0] as usize..k.vertices[1] as usize);
+            for &id in listed.unwrap_or(&[]) {
+                let id = id as usize;
+                let (Some(p), true) = (positions.get(id), id < cache.len()) else {
+                    continue;
+                };
+                let fresh = if *bits {
+                    let Some(word) = seen.get_mut(id / 64) else {
+                        continue;
+                    };
+                    let bit = 1u64 << (id % 64);
+                    let fresh = *word & bit == 0;
+                    *word |= bit;
+                    fresh
+                } else {
+                    match cache.get_mut(id) {
+                        // Marked: not gathered again before it is processed.
+                        Some(e) if e.code & NONFINITE != 0 => {
+                            e.code = 0;
+                            true
+                        }
+                        _ => false,
+                    }
+                };
+                if let (Some(i), Some(a)) = (ids.get_mut(m), at.get_mut(m)) {
+                    (*i, *a) = (id, *p);
+                }
+                m += usize::from(fresh);
+                if m == GATHER {
+                    process_gathered::<S>(stage, mvp, &ids[..], &at[..], &mut out[..], cache);
+                    m = 0;
+                }
+            }
+        }
+        *n = m;
+    }
+
+    /// Processes the gathered vertices into `cache`.
+    fn process<const S: u32>(&mut self, stage: &Stage, mvp: &Mat4, cache: &mut [ProcessedVertex]) {
+        let n = self.n;
+        self.n = 0;
+        if let (Some(ids), Some(at), Some(out)) =
+            (self.ids.get(..n), self.at.get(..n), self.out.get_mut(..n))
+        {
+            process_gathered::<S>(stage, mvp, ids, at, out, cache);
+        }
+    }
+
+    /// Holds the clusters `a..b` of a visit; whether the held runs should
+    /// now be processed and run.
+    fn hold(&mut self, a: usize, b: usize) -> bool {
+        match self.runs.checked_sub(1).and_then(|i| self.held.get_mut(i)) {
+            Some(last) if last.1 == a => last.1 = b,
+            _ => {
+                if let Some(slot) = self.held.get_mut(self.runs) {
+                    *slot = (a, b);
+                    self.runs += 1;
+                }
+            }
+        }
+        self.runs == HELD || 2 * self.n >= GATHER
+    }
+
+    /// Processes the gathered vertices, then runs the held clusters'
+    /// triangles, in order.
+    #[allow(clippy::too_many_arguments)]
+    fn run<const S: u32, const N: usize, K: Sink<N> + ?Sized, A: Attributes<N>>(
+        &mut self,
+        stage: &Stage,
+        mvp: &Mat4,
+        mesh: &Mesh<'_, A>,
+        first_id: u32,
+        clusters: &[Cluster],
+        cache: &mut [ProcessedVertex],
+        drawn: &mut Stats,
+        sink: &mut K,
+    ) {
+        self.process::<S>(stage, mvp, cache);
+        let job = ProcessedJob {
+            mesh,
+            first_id,
+            cache: &*cache,
+        };
+        let runs = self.runs;
+        self.runs = 0;
+        for &(a, b) in self.held.get(..runs).unwrap_or(&[]) {
+            // Validated clusters tile the triangles in order: a run of
+            // them is one range.
+            let (Some(first), Some(last)) = (
+                clusters.get(a),
+                b.checked_sub(1).and_then(|l| clusters.get(l)),
+            ) else {
+                continue;
+            };
+            let tris = first.triangles[0] as usize..last.triangles[1] as usize;
+            job.run_range::<S, N, K>(stage, drawn, sink, tris, 0..cache.len());
+        }
+    }
+}
+
+/// The vertex stage of gathered positions `at`, scattered to their `ids`
+/// in `cache` ([`GatheredWalk`]).
+fn process_gathered<const S: u32>(
+    stage: &Stage,
+    mvp: &Mat4,
+    ids: &[usize],
+    at: &[Vec3],
+    out: &mut [ProcessedVertex],
+    cache: &mut [ProcessedVertex],
+) {
+    let c = &stage.config;
+    process_vertices::<S>(c.width, c.height, stage.guard, mvp, at, out);
+    for (&id, v) in ids.iter().zip(out.iter()) {
+        if let Some(e) = cache.get_mut(id) {
+            *e = *v;
         }
     }
 }

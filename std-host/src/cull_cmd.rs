@@ -65,7 +65,7 @@ pub enum Method {
     Mask(u8),
     /// The floor of every culling before transform: per camera, the
     /// clustered mesh cut to the triangles that per-triangle culling sets
-    /// up, with only their vertices ([`Kept`]), submitted per triangle. A
+    /// up, with only their vertices, submitted per triangle. A
     /// perfect culler that cost nothing would submit that; its cut is made
     /// outside the timing.
     Floor,

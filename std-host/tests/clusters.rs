@@ -247,3 +247,43 @@ fn far_subpixel_triangles_that_snapping_flips() {
         assert_eq!(r.map(|x| x.1), [0; 4]);
     }
 }
+
+/// A mesh of more vertices than the one walk's bitset marks (65,536): its
+/// walk marks the vertices it gathers in the vertex cache instead, and
+/// draws the frame per-triangle culling draws.
+#[test]
+fn a_mesh_beyond_the_walks_bitset_draws_the_same_frame() {
+    use std::f32::consts::PI;
+    let (rings, segments) = (180u32, 370u32);
+    let mut positions = Vec::new();
+    for r in 0..=rings {
+        let theta = PI * r as f32 / rings as f32;
+        for s in 0..segments {
+            let phi = 2.0 * PI * s as f32 / segments as f32;
+            positions.push(microraster::Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ));
+        }
+    }
+    let mut indices = Vec::new();
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * segments + s;
+            let b = r * segments + (s + 1) % segments;
+            indices.push([a, a + segments, b]);
+            indices.push([b, a + segments, b + segments]);
+        }
+    }
+    assert!(positions.len() > 65_536);
+    let m = cluster::build(&positions, &indices, &ClusterOptions::default()).unwrap();
+    assert!(!m.vertex_list.is_empty());
+    for dir in [[0.0, 0.0, 1.0], [1.0, 0.5, 0.0], [-0.3, -1.0, 0.2]] {
+        let mvp = camera(&m, dir, 2.5, [0.0; 3]).unwrap();
+        for (k, (culled, d)) in check::<8>(&m, &mvp, false).into_iter().enumerate() {
+            assert_eq!(d, 0);
+            assert!(culled > 0, "{:?} culled nothing", METHODS[k]);
+        }
+    }
+}
