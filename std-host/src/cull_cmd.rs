@@ -298,8 +298,9 @@ struct Case<'a> {
     config: Config,
     /// The varyings of detail culling's boxes ([`Method::DetailBoxes`]).
     fill: Option<[f32; 3]>,
-    /// Per camera, the mesh a perfect culler submits ([`Method::Floor`]),
-    /// in place of `mesh`.
+    /// Per camera, the cut mesh a floor row submits in place of `mesh`
+    /// ([`Method::FloorVolumes`], [`Method::FloorFacing`],
+    /// [`Method::Floor`]).
     kept: Option<&'a [Kept]>,
 }
 
