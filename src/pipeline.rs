@@ -1307,16 +1307,10 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
 {
     let Parts { stage, stats, sink } = parts;
     let c = &stage.config;
-    // (A walk that marks what it gathers in a bitset needs no marks.)
-    if BATCH == 1 || cache.len() > SEEN {
-        for v in cache.iter_mut() {
-            v.code = NONFINITE;
-        }
-    }
     let (clusters, list) = (set.clusters, set.vertices);
     let (mut drawn, mut skipped) = (Stats::default(), Stats::default());
     if BATCH > 1 {
-        let mut walk = GatheredWalk::new(cache.len());
+        let mut walk = GatheredWalk::new(cache);
         traverse(set, eye.as_ref(), None, cull, |v| match v {
             Visit::Draw(a, b) => {
                 let drawn_now = clusters.get(a..b).unwrap_or(&[]);
@@ -1341,6 +1335,7 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
         *stats += skipped;
         return;
     }
+    mark_stale(cache);
     traverse(set, eye.as_ref(), None, cull, |v| match v {
         Visit::Draw(a, b) => {
             for k in clusters.get(a..b).unwrap_or(&[]) {
@@ -1385,8 +1380,8 @@ fn submit_clusters_in_one_walk<const S: u32, const N: usize, K: Sink<N> + ?Sized
 /// sixteen of the vertex stage's batches.
 const GATHER: usize = 16 * BATCH;
 
-/// Visits whose clusters [`GatheredWalk`] holds back, at most, until their
-/// vertices are processed.
+/// Runs of clusters (adjacent visits merged) that [`GatheredWalk`] holds
+/// back, at most, until their vertices are processed.
 const HELD: usize = 32;
 
 /// Vertices of a mesh that [`GatheredWalk`] marks as gathered with a bit
@@ -1412,9 +1407,11 @@ struct GatheredWalk {
     out: [ProcessedVertex; GATHER],
     /// Entries gathered.
     n: usize,
-    /// One bit a vertex, set when it is gathered; empty for a mesh of
-    /// more than [`SEEN`] vertices.
+    /// One bit a vertex, set when it is gathered.
     seen: [u64; SEEN / 64],
+    /// Whether `seen` is used: the cache has at most [`SEEN`] entries
+    /// (else gathered entries are marked in the cache, all marked stale
+    /// first).
     bits: bool,
     /// The held runs of clusters.
     held: [(usize, usize); HELD],
@@ -1422,14 +1419,20 @@ struct GatheredWalk {
 }
 
 impl GatheredWalk {
-    fn new(vertices: usize) -> Self {
+    /// A walk over `cache`, whose entries it marks stale if it has more
+    /// than [`SEEN`].
+    fn new(cache: &mut [ProcessedVertex]) -> Self {
+        let bits = cache.len() <= SEEN;
+        if !bits {
+            mark_stale(cache);
+        }
         GatheredWalk {
             ids: [0; GATHER],
             at: [Vec3::ZERO; GATHER],
             out: [ProcessedVertex::EMPTY; GATHER],
             n: 0,
             seen: [0; SEEN / 64],
-            bits: vertices <= SEEN,
+            bits,
             held: [(0, 0); HELD],
             runs: 0,
         }
@@ -1557,6 +1560,13 @@ impl GatheredWalk {
             let tris = first.triangles[0] as usize..last.triangles[1] as usize;
             job.run_range::<S, N, K>(stage, drawn, sink, tris, 0..cache.len());
         }
+    }
+}
+
+/// Marks every entry of `cache` stale (not processed this frame).
+fn mark_stale(cache: &mut [ProcessedVertex]) {
+    for v in cache.iter_mut() {
+        v.code = NONFINITE;
     }
 }
 
