@@ -112,6 +112,61 @@ pub(crate) fn round_in_range(v: f32) -> i32 {
     i + up - down
 }
 
+/// `v as i32` for a finite `v` with `|v| < 2^31` (which [`in_coord_range`]
+/// accepted), from the bits of `v` by shifts alone: the vertex stage's
+/// batches (`mesh::process_batch`) convert eight lanes at once this way,
+/// where the compiler keeps `as`'s saturation per lane, six scalar
+/// instructions each. Outside that range some `i32`, never a panic.
+/// (Tests: every exponent, the boundaries, random bit patterns.)
+#[inline(always)]
+pub(crate) fn trunc_in_range(v: f32) -> i32 {
+    let (mag, _) = trunc_magnitude(v);
+    let sign = (v.to_bits() as i32) >> 31;
+    (mag as i32 ^ sign).wrapping_sub(sign)
+}
+
+/// [`round_in_range`] by [`trunc_in_range`]: the same `i32` for every `v`
+/// [`in_coord_range`] accepts.
+#[inline(always)]
+pub(crate) fn round_in_range_by_bits(v: f32) -> i32 {
+    let i = trunc_in_range(v);
+    let f = v - i as f32;
+    let up = (f >= 0.5) as i32;
+    let down = (f < -0.5) as i32;
+    i + up - down
+}
+
+/// [`z01_to_z32`] (`as u32`: saturating, NaN 0) by shifts alone, as
+/// [`trunc_in_range`], for every `f32`.
+#[inline(always)]
+pub(crate) fn z01_to_z32_by_bits(z: f32) -> u32 {
+    let s = z * 4_294_967_296.0;
+    let (mag, exp) = trunc_magnitude(s);
+    let negative = s.to_bits() >> 31 != 0;
+    // At or above 2^32 (infinity too) the most; NaN and below 0 nothing.
+    let v = if exp >= 32 { u32::MAX } else { mag };
+    if negative | s.is_nan() {
+        0
+    } else {
+        v
+    }
+}
+
+/// The magnitude of `v` truncated toward zero, for `|v| < 2^32` (beyond,
+/// some `u32`), and the unbiased exponent of `v`: the significand with its
+/// implicit bit shifted into place.
+#[inline(always)]
+fn trunc_magnitude(v: f32) -> (u32, i32) {
+    let bits = v.to_bits();
+    let exp = ((bits >> 23) & 0xff) as i32 - 127;
+    let m = (bits & 0x7f_ffff) | 0x80_0000;
+    // One shift or the other is 0; below 1 the right shift (at least 24)
+    // leaves nothing of `m < 2^24`.
+    let left = (exp - 23).clamp(0, 8) as u32;
+    let right = (23 - exp).clamp(0, 31) as u32;
+    ((m << left) >> right, exp)
+}
+
 /// `x as i64` (truncation toward zero, saturating, NaN gives 0) without the
 /// library call a 32-bit core makes for it (`__aeabi_f2lz`, about 60
 /// instructions with Rust's saturation around it on a Cortex-M4F): below
@@ -336,6 +391,104 @@ mod tests {
             assert_eq!(super::f32_as_i64_by_parts(x), x as i64, "{x:e}");
         }
         assert_eq!(checked, 2 * 256 * 7);
+    }
+
+    /// The conversions by bits against `as` at every exponent (both ends
+    /// of each binade, its middle, its neighbours, both signs, NaNs and
+    /// infinities): `z01_to_z32_by_bits` for every such `f32`,
+    /// `round_in_range_by_bits` and `trunc_in_range` for those within
+    /// `COORD_LIMIT` (and `trunc_in_range` up to `2^31`).
+    #[test]
+    fn conversions_by_bits_equal_as_at_every_exponent() {
+        let mut checked = 0;
+        for sign in [0u32, 1] {
+            for exp in 0u32..=255 {
+                for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
+                    let x = f32::from_bits(sign << 31 | exp << 23 | mant);
+                    let z = x / 4_294_967_296.0;
+                    assert_eq!(super::z01_to_z32_by_bits(z), super::z01_to_z32(z), "{z:e}");
+                    assert_eq!(super::z01_to_z32_by_bits(x), super::z01_to_z32(x), "{x:e}");
+                    if x.is_finite() && x.abs() < 2147483648.0 {
+                        assert_eq!(super::trunc_in_range(x), x as i32, "{x:e}");
+                        checked += 1;
+                    }
+                    if super::in_coord_range(x) {
+                        let (got, want) =
+                            (super::round_in_range_by_bits(x), super::round_in_range(x));
+                        assert_eq!(got, want, "{x:e}");
+                    }
+                }
+            }
+        }
+        // Exponents -126 (subnormals too) to 30, two signs, seven each.
+        assert_eq!(checked, 2 * 158 * 7);
+        for x in [
+            0.5f32,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.49999997,
+            -0.49999997,
+            8_388_609.0,
+        ] {
+            assert_eq!(
+                super::round_in_range_by_bits(x),
+                super::round_in_range(x),
+                "{x:e}"
+            );
+        }
+        for z in [
+            0.0f32,
+            -0.0,
+            1.0,
+            1.0000001,
+            -1e-30,
+            0.99999994,
+            2.3283064e-10,
+        ] {
+            assert_eq!(super::z01_to_z32_by_bits(z), super::z01_to_z32(z), "{z:e}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Any bit pattern: the conversions by bits equal `as` where
+        /// they are defined to.
+        #[test]
+        fn conversions_by_bits_equal_as(bits in proptest::num::u32::ANY) {
+            let x = f32::from_bits(bits);
+            proptest::prop_assert_eq!(super::z01_to_z32_by_bits(x), super::z01_to_z32(x));
+            if x.is_finite() && x.abs() < 2147483648.0 {
+                proptest::prop_assert_eq!(super::trunc_in_range(x), x as i32);
+            }
+            if super::in_coord_range(x) {
+                proptest::prop_assert_eq!(super::round_in_range_by_bits(x), super::round_in_range(x));
+            }
+        }
+    }
+
+    /// The conversions by bits for every `f32` bit pattern (half a minute
+    /// in release):
+    /// `cargo test --release -p microraster --lib conversions_by_bits_exhaustive -- --ignored`.
+    #[test]
+    #[ignore]
+    fn conversions_by_bits_exhaustive() {
+        for bits in 0..=u32::MAX {
+            let x = f32::from_bits(bits);
+            assert_eq!(
+                super::z01_to_z32_by_bits(x),
+                super::z01_to_z32(x),
+                "{bits:#x}"
+            );
+            if x.is_finite() && x.abs() < 2147483648.0 {
+                assert_eq!(super::trunc_in_range(x), x as i32, "{bits:#x}");
+            }
+            if super::in_coord_range(x) {
+                let (got, want) = (super::round_in_range_by_bits(x), super::round_in_range(x));
+                assert_eq!(got, want, "{bits:#x}");
+            }
+        }
     }
 
     /// Every `f32` bit pattern (4 billion; about a minute in release):

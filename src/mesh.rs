@@ -362,7 +362,10 @@ pub(crate) const BATCH: usize = if cfg!(target_pointer_width = "64") {
 /// far planes and the guard band, with `w > 0` and a window position that
 /// snaps. Then it writes what [`ProcessedVertex::new`] gives for each
 /// (the same `f32` operations in the same order, through the same
-/// [`crate::fixed::window_inv`] and rounding) and returns `true`;
+/// [`crate::fixed::window_inv`]; the roundings to `Sub<S>` and `Z32` by
+/// [`crate::fixed::round_in_range_by_bits`] and
+/// [`crate::fixed::z01_to_z32_by_bits`], the same integers by shifts that
+/// vectorize) and returns `true`;
 /// otherwise it writes nothing and returns `false`, and the caller
 /// processes the batch vertex by vertex. (Test:
 /// `batches_equal_the_vertex_by_vertex_stage`.)
@@ -375,40 +378,82 @@ fn process_batch<const S: u32>(
     positions: &[Vec3],
     out: &mut [ProcessedVertex],
 ) -> bool {
-    use crate::fixed::{in_coord_range, round_in_range, window_inv, z01_to_z32};
-    let mut pos = [Vec4::new(0.0, 0.0, 0.0, 0.0); BATCH];
-    for (q, p) in pos.iter_mut().zip(positions) {
-        *q = mvp.transform_point(*p);
+    use crate::clip::outcode::*;
+    use crate::fixed::{in_coord_range, round_in_range_by_bits, window_inv, z01_to_z32_by_bits};
+    let (Some(positions), Some(out)) = (positions.get(..BATCH), out.get_mut(..BATCH)) else {
+        return false;
+    };
+    // Lane by lane, each quantity in an array of its own (structure of
+    // arrays), one loop a step: the loops become vector code over all
+    // `BATCH` lanes. Each lane's operations are `ProcessedVertex::new`'s,
+    // in its order: `Mat4::transform_point` (`w = 1` times its column
+    // too), `outcode`'s comparisons, `window_inv`, the rounding.
+    let (mut px, mut py, mut pz) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
+    for (k, p) in positions.iter().enumerate() {
+        (px[k], py[k], pz[k]) = (p.x, p.y, p.z);
+    }
+    let c = &mvp.cols;
+    let row = |i: usize, out: &mut [f32; BATCH]| {
+        for k in 0..BATCH {
+            out[k] = c[0][i] * px[k] + c[1][i] * py[k] + c[2][i] * pz[k] + c[3][i] * 1.0;
+        }
+    };
+    let (mut x, mut y, mut z, mut w) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
+    row(0, &mut x);
+    row(1, &mut y);
+    row(2, &mut z);
+    row(3, &mut w);
+    let mut code = [0u16; BATCH];
+    for k in 0..BATCH {
+        let (x, y, z, w) = (x[k], y[k], z[k], w[k]);
+        let (xg, yg) = (gx * w, gy * w);
+        let bit = |b: bool, plane: u16| u16::from(b) * plane;
+        code[k] = bit(x < -w, LEFT)
+            | bit(x > w, RIGHT)
+            | bit(y < -w, BOTTOM)
+            | bit(y > w, TOP)
+            | bit(z < -w, NEAR)
+            | bit(z > w, FAR)
+            | bit(x < -xg, GUARD_LEFT)
+            | bit(x > xg, GUARD_RIGHT)
+            | bit(y < -yg, GUARD_BOTTOM)
+            | bit(y > yg, GUARD_TOP);
+    }
+    let mut inv = [0f32; BATCH];
+    for k in 0..BATCH {
+        inv[k] = 1.0 / w[k];
+    }
+    let (mut wx, mut wy, mut zw) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
+    for k in 0..BATCH {
+        (wx[k], wy[k], zw[k]) = window_inv::<S>(x[k], y[k], z[k], inv[k], width, height);
     }
     let mut ok = true;
-    let mut code = [0u16; BATCH];
-    let mut inv = [0f32; BATCH];
-    let mut win = [(0f32, 0f32, 0f32); BATCH];
     for k in 0..BATCH {
-        let p = pos[k];
-        code[k] = outcode(p, gx, gy);
-        inv[k] = 1.0 / p.w;
-        win[k] = window_inv::<S>(p.x, p.y, p.z, inv[k], width, height);
-        let (wx, wy, zw) = win[k];
-        ok &= p.is_finite()
-            & (code[k] & crate::clip::outcode::CLIP == 0)
-            & (p.w > 0.0)
-            & zw.is_finite()
-            & in_coord_range(wx)
-            & in_coord_range(wy);
+        let finite = x[k].is_finite() & y[k].is_finite() & z[k].is_finite() & w[k].is_finite();
+        ok &= finite
+            & (code[k] & CLIP == 0)
+            & (w[k] > 0.0)
+            & zw[k].is_finite()
+            & in_coord_range(wx[k])
+            & in_coord_range(wy[k]);
     }
     if !ok {
         return false;
     }
+    let (mut sx, mut sy, mut sz) = ([0i32; BATCH], [0i32; BATCH], [0u32; BATCH]);
+    for k in 0..BATCH {
+        sx[k] = round_in_range_by_bits(wx[k]);
+        sy[k] = round_in_range_by_bits(wy[k]);
+        sz[k] = z01_to_z32_by_bits(zw[k]);
+    }
     for (k, v) in out.iter_mut().enumerate() {
-        let (wx, wy, zw) = win[k];
         *v = ProcessedVertex {
-            pos: pos[k],
+            pos: Vec4::new(x[k], y[k], z[k], w[k]),
             inv_w: inv[k],
             snap: crate::fixed::SnappedVertex {
-                x: round_in_range(wx),
-                y: round_in_range(wy),
-                z: z01_to_z32(zw),
+                x: sx[k],
+                y: sy[k],
+                z: sz[k],
             },
             code: code[k],
             snapped: true,
