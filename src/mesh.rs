@@ -378,7 +378,7 @@ fn process_batch<const S: u32>(
     positions: &[Vec3],
     out: &mut [ProcessedVertex],
 ) -> bool {
-    use crate::clip::outcode::*;
+    use crate::clip::outcode::CLIP;
     use crate::fixed::{in_coord_range, round_in_range_by_bits, window_inv, z01_to_z32_by_bits};
     let (Some(positions), Some(out)) = (positions.get(..BATCH), out.get_mut(..BATCH)) else {
         return false;
@@ -387,7 +387,7 @@ fn process_batch<const S: u32>(
     // arrays), one loop a step: the loops become vector code over all
     // `BATCH` lanes. Each lane's operations are `ProcessedVertex::new`'s,
     // in its order: `Mat4::transform_point` (`w = 1` times its column
-    // too), `outcode`'s comparisons, `window_inv`, the rounding.
+    // too), `outcode`, `window_inv`, the rounding.
     let (mut px, mut py, mut pz) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
     for (k, p) in positions.iter().enumerate() {
         (px[k], py[k], pz[k]) = (p.x, p.y, p.z);
@@ -405,19 +405,7 @@ fn process_batch<const S: u32>(
     row(3, &mut w);
     let mut code = [0u16; BATCH];
     for k in 0..BATCH {
-        let (x, y, z, w) = (x[k], y[k], z[k], w[k]);
-        let (xg, yg) = (gx * w, gy * w);
-        let bit = |b: bool, plane: u16| u16::from(b) * plane;
-        code[k] = bit(x < -w, LEFT)
-            | bit(x > w, RIGHT)
-            | bit(y < -w, BOTTOM)
-            | bit(y > w, TOP)
-            | bit(z < -w, NEAR)
-            | bit(z > w, FAR)
-            | bit(x < -xg, GUARD_LEFT)
-            | bit(x > xg, GUARD_RIGHT)
-            | bit(y < -yg, GUARD_BOTTOM)
-            | bit(y > yg, GUARD_TOP);
+        code[k] = outcode(Vec4::new(x[k], y[k], z[k], w[k]), gx, gy);
     }
     let mut inv = [0f32; BATCH];
     for k in 0..BATCH {
