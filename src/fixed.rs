@@ -102,10 +102,15 @@ pub(crate) fn in_coord_range(v: f32) -> bool {
 /// other `v` some `i32`, never a panic.
 #[inline(always)]
 pub(crate) fn round_in_range(v: f32) -> i32 {
-    // |v| <= 2^28: `as` truncates exactly, `i as f32` is exact (below 2^24
-    // every integer is representable; above it `v` is an integer), and so
-    // is the fraction `f = v - i`, in (-1, 1). Halves go up.
-    let i = v as i32;
+    round_from(v, v as i32)
+}
+
+/// `v` rounded to nearest, halves up, from `i`, `v` truncated toward zero.
+/// For `|v| <= 2^28`, `i as f32` is exact (below 2^24 every integer is
+/// representable; above it `v` is an integer), and so is the fraction `f
+/// = v - i`, in (-1, 1).
+#[inline(always)]
+fn round_from(v: f32, i: i32) -> i32 {
     let f = v - i as f32;
     let up = (f >= 0.5) as i32;
     let down = (f < -0.5) as i32;
@@ -129,11 +134,7 @@ pub(crate) fn trunc_in_range(v: f32) -> i32 {
 /// [`in_coord_range`] accepts.
 #[inline(always)]
 pub(crate) fn round_in_range_by_bits(v: f32) -> i32 {
-    let i = trunc_in_range(v);
-    let f = v - i as f32;
-    let up = (f >= 0.5) as i32;
-    let down = (f < -0.5) as i32;
-    i + up - down
+    round_from(v, trunc_in_range(v))
 }
 
 /// [`z01_to_z32`] (`as u32`: saturating, NaN 0) by shifts alone, as
@@ -360,26 +361,34 @@ pub const fn pixel_center<const S: u32>(i: i32) -> i64 {
 
 #[cfg(test)]
 mod tests {
+    /// Calls `f` with seven values of every binade: both ends, the middle,
+    /// the neighbours of the ends, both signs (NaNs and infinities among
+    /// them).
+    fn at_every_exponent(mut f: impl FnMut(f32)) {
+        for sign in [0u32, 1] {
+            for exp in 0u32..=255 {
+                for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
+                    f(f32::from_bits(sign << 31 | exp << 23 | mant));
+                }
+            }
+        }
+    }
+
     /// `f32_as_i64_by_parts` against `as` at every exponent: both ends of each
     /// binade, its middle, its neighbours, both signs, plus NaNs and
     /// infinities.
     #[test]
     fn f32_as_i64_equals_as_at_every_exponent() {
         let mut checked = 0;
-        for sign in [0u32, 1] {
-            for exp in 0u32..=255 {
-                for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
-                    let x = f32::from_bits(sign << 31 | exp << 23 | mant);
-                    assert_eq!(
-                        super::f32_as_i64_by_parts(x),
-                        x as i64,
-                        "{x:e} ({:#x})",
-                        x.to_bits()
-                    );
-                    checked += 1;
-                }
-            }
-        }
+        at_every_exponent(|x| {
+            assert_eq!(
+                super::f32_as_i64_by_parts(x),
+                x as i64,
+                "{x:e} ({:#x})",
+                x.to_bits()
+            );
+            checked += 1;
+        });
         for x in [
             2147483648.0f32,
             -2147483648.0,
@@ -401,25 +410,19 @@ mod tests {
     #[test]
     fn conversions_by_bits_equal_as_at_every_exponent() {
         let mut checked = 0;
-        for sign in [0u32, 1] {
-            for exp in 0u32..=255 {
-                for mant in [0u32, 1, 2, 0x40_0000, 0x55_5555, 0x7f_fffe, 0x7f_ffff] {
-                    let x = f32::from_bits(sign << 31 | exp << 23 | mant);
-                    let z = x / 4_294_967_296.0;
-                    assert_eq!(super::z01_to_z32_by_bits(z), super::z01_to_z32(z), "{z:e}");
-                    assert_eq!(super::z01_to_z32_by_bits(x), super::z01_to_z32(x), "{x:e}");
-                    if x.is_finite() && x.abs() < 2147483648.0 {
-                        assert_eq!(super::trunc_in_range(x), x as i32, "{x:e}");
-                        checked += 1;
-                    }
-                    if super::in_coord_range(x) {
-                        let (got, want) =
-                            (super::round_in_range_by_bits(x), super::round_in_range(x));
-                        assert_eq!(got, want, "{x:e}");
-                    }
-                }
+        at_every_exponent(|x| {
+            let z = x / 4_294_967_296.0;
+            assert_eq!(super::z01_to_z32_by_bits(z), super::z01_to_z32(z), "{z:e}");
+            assert_eq!(super::z01_to_z32_by_bits(x), super::z01_to_z32(x), "{x:e}");
+            if x.is_finite() && x.abs() < 2147483648.0 {
+                assert_eq!(super::trunc_in_range(x), x as i32, "{x:e}");
+                checked += 1;
             }
-        }
+            if super::in_coord_range(x) {
+                let (got, want) = (super::round_in_range_by_bits(x), super::round_in_range(x));
+                assert_eq!(got, want, "{x:e}");
+            }
+        });
         // Exponents -126 (subnormals too) to 30, two signs, seven each.
         assert_eq!(checked, 2 * 158 * 7);
         for x in [
