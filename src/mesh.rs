@@ -386,23 +386,13 @@ fn process_batch<const S: u32>(
     // Lane by lane, each quantity in an array of its own (structure of
     // arrays), one loop a step: the loops become vector code over all
     // `BATCH` lanes. Each lane's operations are `ProcessedVertex::new`'s,
-    // in its order: `Mat4::transform_point` (`w = 1` times its column
-    // too), `outcode`, `window_inv`, the rounding.
-    let (mut px, mut py, mut pz) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
-    for (k, p) in positions.iter().enumerate() {
-        (px[k], py[k], pz[k]) = (p.x, p.y, p.z);
-    }
-    let c = &mvp.cols;
-    let row = |i: usize, out: &mut [f32; BATCH]| {
-        for k in 0..BATCH {
-            out[k] = c[0][i] * px[k] + c[1][i] * py[k] + c[2][i] * pz[k] + c[3][i] * 1.0;
-        }
-    };
+    // in its order: `Mat4::transform_point`, `outcode`, `window_inv`, the
+    // rounding.
     let (mut x, mut y, mut z, mut w) = ([0f32; BATCH], [0f32; BATCH], [0f32; BATCH], [0f32; BATCH]);
-    row(0, &mut x);
-    row(1, &mut y);
-    row(2, &mut z);
-    row(3, &mut w);
+    for (k, p) in positions.iter().enumerate() {
+        let q = mvp.transform_point(*p);
+        (x[k], y[k], z[k], w[k]) = (q.x, q.y, q.z, q.w);
+    }
     let mut code = [0u16; BATCH];
     for k in 0..BATCH {
         code[k] = outcode(Vec4::new(x[k], y[k], z[k], w[k]), gx, gy);
@@ -417,8 +407,7 @@ fn process_batch<const S: u32>(
     }
     let mut ok = true;
     for k in 0..BATCH {
-        let finite = x[k].is_finite() & y[k].is_finite() & z[k].is_finite() & w[k].is_finite();
-        ok &= finite
+        ok &= Vec4::new(x[k], y[k], z[k], w[k]).is_finite()
             & (code[k] & CLIP == 0)
             & (w[k] > 0.0)
             & zw[k].is_finite()
